@@ -1,0 +1,176 @@
+// The `frostmpm` command: run, check, plugins, describe.
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "frostmpm/config/input_error.hpp"
+#include "frostmpm/scene/plugin_setup.hpp"
+#include "reference.hpp"
+#include "task.hpp"
+
+namespace fs = std::filesystem;
+using namespace frostmpm;
+
+namespace {
+
+struct SceneOptions {
+  std::string scene;
+  std::vector<std::string> overrides;
+  std::vector<std::string> plugin_paths;
+};
+
+void add_scene_options(CLI::App* cmd, SceneOptions& o) {
+  cmd->add_option("scene", o.scene, "scene file (YAML)")->required();
+  cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value")
+      ->take_all();
+  cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)");
+}
+
+/// Everything up to (not including) execution: parse, override, load plugins, validate.
+struct PreparedScene {
+  Registry registry;
+  std::unique_ptr<PluginLoader> loader;
+  std::unique_ptr<ConfigNode> root;
+  std::unique_ptr<app::Task> task;
+  std::string task_name;
+  YAML::Node resolved;
+};
+
+std::unique_ptr<PreparedScene> prepare(const SceneOptions& o) {
+  auto prepared = std::make_unique<PreparedScene>();
+  ConfigNode file_root = ConfigNode::load_file(o.scene);
+  YAML::Node tree = file_root.raw();
+  for (const auto& assignment : o.overrides) apply_override(tree, assignment);
+  prepared->root = std::make_unique<ConfigNode>(tree, o.scene);
+  const ConfigNode& root = *prepared->root;
+
+  prepared->loader = std::make_unique<PluginLoader>(prepared->registry);
+  PluginSetup setup{o.plugin_paths};
+  setup.load_defaults(*prepared->loader);
+  setup.load_scene_paths(*prepared->loader, root);
+  for (const auto& warning : refusal_warnings(*prepared->loader)) std::cerr << "warning: " << warning << "\n";
+
+  std::vector<std::string> task_names;
+  for (const auto& [name, _] : app::tasks()) task_names.push_back(name);
+  const ConfigNode task_node = root.child("task");
+  prepared->task_name = task_node.as_string();
+  const auto it = app::tasks().find(prepared->task_name);
+  if (it == app::tasks().end()) {
+    std::string message = "unknown task '" + prepared->task_name + "'";
+    const std::string hint = closest_match(prepared->task_name, task_names);
+    if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+    throw task_node.error(message + " Valid: " + join(task_names));
+  }
+  prepared->task = it->second(app::TaskContext{prepared->registry, *prepared->loader, root});
+  std::vector<std::string> valid = {"task", "plugin_paths"};
+  for (const auto& s : prepared->task->sections()) valid.push_back(s);
+  root.finish(valid);
+
+  prepared->resolved = YAML::Node(YAML::NodeType::Map);
+  prepared->resolved["task"] = prepared->task_name;
+  for (const auto& kv : prepared->task->resolved()) prepared->resolved[kv.first] = kv.second;
+  return prepared;
+}
+
+nlohmann::json to_json(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map: {
+      nlohmann::json j = nlohmann::json::object();
+      for (const auto& kv : node) j[kv.first.as<std::string>()] = to_json(kv.second);
+      return j;
+    }
+    case YAML::NodeType::Sequence: {
+      nlohmann::json j = nlohmann::json::array();
+      for (const auto& item : node) j.push_back(to_json(item));
+      return j;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string& text = node.Scalar();
+      double number = 0;
+      bool flag = false;
+      if (node.Tag() != "!" && YAML::convert<double>::decode(node, number)) return number;
+      if (node.Tag() != "!" && YAML::convert<bool>::decode(node, flag)) return flag;
+      return text;
+    }
+    default: return nullptr;
+  }
+}
+
+int cmd_run(const SceneOptions& o, const std::string& out_dir) {
+  const auto start = std::chrono::steady_clock::now();
+  auto prepared = prepare(o);
+  const std::string dir = out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
+  OutputDir out(dir);
+  prepared->task->execute(out);
+
+  nlohmann::json summary;
+  summary["frostmpm_version"] = FROSTMPM_VERSION;
+  summary["scene"] = o.scene;
+  summary["task"] = prepared->task_name;
+  summary["overrides"] = o.overrides;
+  summary["plugins"] = nlohmann::json::array();
+  for (const auto& p : prepared->loader->loaded())
+    summary["plugins"].push_back({{"name", p.name}, {"version", p.version}, {"library", p.file}});
+  summary["resolved_scene"] = to_json(prepared->resolved);
+  summary["wall_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.write_text("run.json", summary.dump(2) + "\n");
+  std::cout << "frostmpm: task '" << prepared->task_name << "' finished; results in " << dir << "\n";
+  return 0;
+}
+
+int cmd_check(const SceneOptions& o) {
+  auto prepared = prepare(o);
+  YAML::Emitter emitter;
+  emitter << prepared->resolved;
+  std::cout << "# " << o.scene << ": valid. Resolved scene with defaults:\n" << emitter.c_str() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"FrostMPM — thermo-hydro-mechanical material point method for freezing and thawing ground"};
+  cli.require_subcommand(1);
+  cli.set_version_flag("--version", FROSTMPM_VERSION);
+
+  SceneOptions run_options, check_options;
+  std::string out_dir;
+  auto* run = cli.add_subcommand("run", "run a scene");
+  add_scene_options(run, run_options);
+  run->add_option("-o,--output", out_dir, "output folder (default: frostmpm-out/<scene name>)");
+
+  auto* check = cli.add_subcommand("check", "validate a scene and print it with defaults filled in");
+  add_scene_options(check, check_options);
+
+  std::vector<std::string> list_paths;
+  auto* plugins = cli.add_subcommand("plugins", "list every registered model by kind, with library and version");
+  plugins->add_option("--plugin-path", list_paths, "extra plugin folder or library (repeatable)");
+
+  std::string describe_target;
+  bool markdown = false;
+  std::vector<std::string> describe_paths;
+  auto* describe = cli.add_subcommand("describe", "show a model's parameters: units, defaults, ranges, docs");
+  describe->add_option("target", describe_target, "KIND/NAME (e.g. sfcc/exponential), KIND, or 'all'")
+      ->required();
+  describe->add_flag("--markdown", markdown, "print Markdown (used to generate docs/config-reference.md)");
+  describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)");
+
+  try {
+    CLI11_PARSE(cli, argc, argv);
+    if (*run) return cmd_run(run_options, out_dir);
+    if (*check) return cmd_check(check_options);
+    if (*plugins) return app::cmd_plugins(list_paths, std::cout);
+    if (*describe) return app::cmd_describe(describe_target, markdown, describe_paths, std::cout);
+  } catch (const InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kInputErrorExitCode;
+  } catch (const std::exception& e) {
+    std::cerr << "internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,84 @@
+#include "reference.hpp"
+
+#include <iomanip>
+#include <iostream>
+
+#include "frostmpm/scene/plugin_setup.hpp"
+
+namespace frostmpm::app {
+namespace {
+
+struct LoadedRegistry {
+  Registry registry;
+  PluginLoader loader{registry};
+  explicit LoadedRegistry(const std::vector<std::string>& extra_paths) {
+    PluginSetup{extra_paths}.load_defaults(loader);
+  }
+};
+
+void describe_text(const RegistryEntry& e, std::ostream& out) {
+  out << e.kind << "/" << e.name << " — " << e.doc << "\n";
+  out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
+  out << "  YAML: {model: " << e.name << (e.schema.params().empty() ? "" : ", ...") << "}\n";
+  for (const auto& p : e.schema.params()) {
+    out << "  " << std::left << std::setw(22) << p.name << std::setw(14) << to_string(p.type)
+        << std::setw(10) << (p.unit.empty() ? "-" : p.unit) << std::setw(16) << p.default_text();
+    const std::string range = p.type == ParamType::Choice ? "one of: " + join(p.choices) : p.range_text();
+    out << std::setw(16) << range << " " << p.doc << "\n";
+  }
+}
+
+void describe_markdown(const RegistryEntry& e, std::ostream& out) {
+  out << "### `" << e.kind << "/" << e.name << "`\n\n" << e.doc << ".\n\n";
+  out << "Plugin `" << e.plugin << "`. Scene form: `{model: " << e.name << ", ...}`.\n\n";
+  out << "| parameter | type | unit | default | allowed | description |\n|---|---|---|---|---|---|\n";
+  for (const auto& p : e.schema.params()) {
+    const std::string range = p.type == ParamType::Choice ? join(p.choices) : p.range_text();
+    out << "| `" << p.name << "` | " << to_string(p.type) << " | " << (p.unit.empty() ? "-" : p.unit)
+        << " | " << p.default_text() << " | " << (range.empty() ? "any" : range) << " | " << p.doc << " |\n";
+  }
+  out << "\n";
+}
+
+}  // namespace
+
+int cmd_plugins(const std::vector<std::string>& extra_paths, std::ostream& out) {
+  LoadedRegistry loaded(extra_paths);
+  for (const auto& kind : loaded.registry.kinds()) {
+    out << kind << ":\n";
+    for (const auto* e : loaded.registry.entries(kind))
+      out << "  " << std::left << std::setw(24) << e->name << std::setw(10) << e->version << e->library << "\n";
+  }
+  for (const auto& r : loaded.loader.refused()) out << "refused: " << r.file << ": " << r.reason << "\n";
+  return 0;
+}
+
+int cmd_describe(const std::string& target, bool markdown, const std::vector<std::string>& extra_paths,
+                 std::ostream& out) {
+  LoadedRegistry loaded(extra_paths);
+  const Registry& registry = loaded.registry;
+  std::vector<const RegistryEntry*> selected;
+  const auto slash = target.find('/');
+  if (target == "all") {
+    for (const auto& kind : registry.kinds())
+      for (const auto* e : registry.entries(kind)) selected.push_back(e);
+  } else if (slash == std::string::npos) {
+    selected = registry.entries(target);
+    if (selected.empty())
+      throw InputError("describe: unknown kind '" + target + "'. Kinds: " + join(registry.kinds()));
+  } else {
+    selected.push_back(&registry.get(target.substr(0, slash), target.substr(slash + 1), {"describe", "", 0, 0}));
+  }
+  std::string current_kind;
+  for (const auto* e : selected) {
+    if (markdown && e->kind != current_kind) {
+      current_kind = e->kind;
+      out << "## " << current_kind << "\n\n";
+    }
+    if (markdown) describe_markdown(*e, out);
+    else describe_text(*e, out);
+  }
+  return 0;
+}
+
+}  // namespace frostmpm::app

@@ -1,0 +1,40 @@
+#pragma once
+// What `frostmpm run` executes: a task named by the scene's `task:` key. A task reads and
+// validates all of its input in its constructor (so `check` runs the same code), and only
+// execute() writes to the output folder.
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <yaml-cpp/yaml.h>
+
+#include "frostmpm/config/config_node.hpp"
+#include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/plugin/plugin_loader.hpp"
+
+namespace frostmpm::app {
+
+struct TaskContext {
+  const Registry& registry;
+  const PluginLoader& loader;
+  const ConfigNode& root;  ///< scene root; a task consumes the sections it owns
+};
+
+class Task {
+ public:
+  virtual ~Task() = default;
+  /// Top-level keys this task owns (besides `task` and `plugin_paths`).
+  virtual std::vector<std::string> sections() const = 0;
+  /// The scene as it will run: every section with defaults filled in.
+  virtual YAML::Node resolved() const = 0;
+  virtual void execute(const OutputDir& out) = 0;
+};
+
+using TaskFactory = std::function<std::unique_ptr<Task>(const TaskContext&)>;
+/// Registered tasks by name.
+const std::map<std::string, TaskFactory>& tasks();
+
+std::unique_ptr<Task> make_freezing_curves_task(const TaskContext& context);
+
+}  // namespace frostmpm::app

@@ -1,0 +1,197 @@
+#include "frostmpm/config/config_node.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace frostmpm {
+
+ConfigNode::ConfigNode(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)),
+      file_(std::move(file)),
+      path_(std::move(path)),
+      consumed_(std::make_shared<std::set<std::string>>()) {}
+
+ConfigNode ConfigNode::load_file(const std::string& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec))
+    throw InputError(file + ": scene file does not exist");
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(file + ": is a directory, expected a YAML scene file");
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot be read");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return load_string(buffer.str(), file);
+}
+
+ConfigNode ConfigNode::load_string(const std::string& text, const std::string& name) {
+  try {
+    YAML::Node root = YAML::Load(text);
+    if (!root.IsMap())
+      throw InputError(name + ": a scene must be a YAML mapping of sections (key: value)");
+    return ConfigNode(root, name, "");
+  } catch (const YAML::ParserException& e) {
+    SourceLocation where{name, "", e.mark.line + 1, e.mark.column + 1};
+    throw InputError(where, "malformed YAML: " + e.msg);
+  }
+}
+
+SourceLocation ConfigNode::where() const {
+  SourceLocation loc{file_, path_, 0, 0};
+  if (node_ && node_.Mark().line >= 0 && !node_.Mark().is_null()) {
+    loc.line = node_.Mark().line + 1;
+    loc.column = node_.Mark().column + 1;
+  }
+  return loc;
+}
+
+std::string ConfigNode::child_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+bool ConfigNode::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined();
+}
+
+std::vector<std::string> ConfigNode::keys() const {
+  std::vector<std::string> out;
+  if (!node_.IsMap()) return out;
+  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
+ConfigNode ConfigNode::child(const std::string& key) const {
+  if (!node_.IsMap()) throw error("expected a mapping containing '" + key + "'");
+  const YAML::Node c = node_[key];
+  if (!c.IsDefined()) {
+    SourceLocation loc = where();
+    throw InputError(loc, "missing required key '" + key + "'");
+  }
+  consumed_->insert(key);
+  return ConfigNode(c, file_, child_path(key));
+}
+
+std::optional<ConfigNode> ConfigNode::optional_child(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  return child(key);
+}
+
+void ConfigNode::finish(const std::vector<std::string>& valid_keys) const {
+  if (!node_.IsMap()) return;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (consumed_->count(key)) continue;
+    ConfigNode offending(kv.first, file_, child_path(key));
+    std::string message = "unknown key '" + key + "'";
+    const std::string hint = closest_match(key, valid_keys);
+    if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+    message += " Valid keys here: " + (valid_keys.empty() ? std::string("(none)") : join(valid_keys));
+    throw offending.error(message);
+  }
+}
+
+std::vector<ConfigNode> ConfigNode::elements() const {
+  if (!node_.IsSequence()) throw error("expected a list");
+  std::vector<ConfigNode> out;
+  std::size_t i = 0;
+  for (const auto& item : node_) out.emplace_back(item, file_, child_path(std::to_string(i++)));
+  return out;
+}
+
+namespace {
+std::string scalar_text(const YAML::Node& n) { return n.IsScalar() ? n.Scalar() : std::string("<non-scalar>"); }
+}  // namespace
+
+double ConfigNode::as_real() const {
+  if (!node_.IsScalar()) throw error("expected a number");
+  double value = 0;
+  if (!YAML::convert<double>::decode(node_, value))
+    throw error("expected a number, got '" + scalar_text(node_) + "'");
+  if (!std::isfinite(value)) throw error("expected a finite number, got '" + scalar_text(node_) + "'");
+  return value;
+}
+
+long ConfigNode::as_integer() const {
+  if (!node_.IsScalar()) throw error("expected an integer");
+  long value = 0;
+  if (!YAML::convert<long>::decode(node_, value))
+    throw error("expected an integer, got '" + scalar_text(node_) + "'");
+  return value;
+}
+
+bool ConfigNode::as_bool() const {
+  bool value = false;
+  if (!node_.IsScalar() || !YAML::convert<bool>::decode(node_, value))
+    throw error("expected true or false, got '" + scalar_text(node_) + "'");
+  return value;
+}
+
+std::string ConfigNode::as_string() const {
+  if (!node_.IsScalar()) throw error("expected a string");
+  return node_.Scalar();
+}
+
+std::vector<double> ConfigNode::as_reals() const {
+  if (node_.IsScalar()) return {as_real()};
+  std::vector<double> out;
+  for (const auto& e : elements()) out.push_back(e.as_real());
+  return out;
+}
+
+void apply_override(YAML::Node& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set '" + assignment + "': expected path.to.key=value");
+  const std::string path = assignment.substr(0, eq);
+  const std::string value = assignment.substr(eq + 1);
+
+  std::vector<std::string> parts;
+  std::stringstream ss(path);
+  for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+
+  YAML::Node node = root;
+  std::string walked;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    YAML::Node next;
+    if (node.IsSequence()) {
+      char* end = nullptr;
+      const long index = std::strtol(part.c_str(), &end, 10);
+      if (*end != '\0' || index < 0 || index >= static_cast<long>(node.size()))
+        throw InputError("--set " + path + ": '" + part + "' is not an index of the list at '" +
+                         walked + "' (size " + std::to_string(node.size()) + ")");
+      next = node[index];
+    } else if (node.IsMap() && node[part].IsDefined()) {
+      next = node[part];
+    } else {
+      std::vector<std::string> keys;
+      if (node.IsMap())
+        for (const auto& kv : node) keys.push_back(kv.first.as<std::string>());
+      std::string message = "--set " + path + ": path does not exist: no key '" + part + "' at '" +
+                            (walked.empty() ? "<top>" : walked) + "'";
+      const std::string hint = closest_match(part, keys);
+      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+      if (!keys.empty()) message += " Keys there: " + join(keys);
+      throw InputError(message);
+    }
+    walked += (walked.empty() ? "" : ".") + part;
+    node.reset(next);
+  }
+  if (!node.IsMap() && !node.IsSequence())
+    throw InputError("--set " + path + ": '" + walked + "' is a value, not a section");
+  YAML::Node parsed = YAML::Load(value);
+  if (node.IsSequence()) {
+    char* end = nullptr;
+    const long index = std::strtol(parts.back().c_str(), &end, 10);
+    if (*end != '\0' || index < 0 || index >= static_cast<long>(node.size()))
+      throw InputError("--set " + path + ": '" + parts.back() + "' is not an index of '" + walked + "'");
+    node[index] = parsed;
+  } else {
+    // A new leaf is allowed here: strict validation later rejects it if the schema has no such key.
+    node[parts.back()] = parsed;
+  }
+}
+
+}  // namespace frostmpm

@@ -1,0 +1,66 @@
+#pragma once
+// Strict view over a YAML scene: every key read is marked consumed, and finish() rejects the
+// rest with the closest valid name. All conversions report the YAML path and line on failure.
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "frostmpm/config/input_error.hpp"
+
+namespace frostmpm {
+
+class ConfigNode {
+ public:
+  ConfigNode(YAML::Node node, std::string file, std::string path = "");
+
+  /// Parses a scene file; a missing file or malformed YAML is an InputError.
+  static ConfigNode load_file(const std::string& file);
+  static ConfigNode load_string(const std::string& text, const std::string& name = "<string>");
+
+  const std::string& path() const { return path_; }
+  const std::string& file() const { return file_; }
+  SourceLocation where() const;
+  InputError error(const std::string& message) const { return InputError(where(), message); }
+
+  bool is_map() const { return node_.IsMap(); }
+  bool is_sequence() const { return node_.IsSequence(); }
+  bool is_scalar() const { return node_.IsScalar(); }
+  bool is_null() const { return !node_ || node_.IsNull(); }
+
+  // ---- maps (keys read here count as consumed) ----
+  bool has(const std::string& key) const;
+  ConfigNode child(const std::string& key) const;  ///< required key
+  std::optional<ConfigNode> optional_child(const std::string& key) const;
+  std::vector<std::string> keys() const;
+  /// Throws for the first key nobody read, naming the closest entry of `valid_keys`.
+  void finish(const std::vector<std::string>& valid_keys) const;
+
+  // ---- sequences ----
+  std::vector<ConfigNode> elements() const;
+
+  // ---- scalars ----
+  double as_real() const;
+  long as_integer() const;
+  bool as_bool() const;
+  std::string as_string() const;
+  std::vector<double> as_reals() const;
+
+  const YAML::Node& raw() const { return node_; }
+
+ private:
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+  std::shared_ptr<std::set<std::string>> consumed_;
+  std::string child_path(const std::string& key) const;
+};
+
+/// Applies "a.b.c=value" to a scene tree. The parent of the leaf must exist (a list index
+/// is a number: "regions.0.material"); a wrong path is an InputError listing valid keys.
+void apply_override(YAML::Node& root, const std::string& assignment);
+
+}  // namespace frostmpm

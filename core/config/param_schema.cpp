@@ -1,0 +1,215 @@
+#include "frostmpm/config/param_schema.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace frostmpm {
+
+std::string to_string(ParamType type) {
+  switch (type) {
+    case ParamType::Real: return "real";
+    case ParamType::Integer: return "integer";
+    case ParamType::Boolean: return "boolean";
+    case ParamType::String: return "string";
+    case ParamType::Choice: return "choice";
+    case ParamType::RealList: return "list of reals";
+  }
+  return "?";
+}
+
+namespace {
+std::string number_text(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+YAML::Node to_yaml(const ParamValue& value) {
+  YAML::Node node;
+  std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, std::vector<double>>) {
+          node = YAML::Node(YAML::NodeType::Sequence);
+          for (double x : v) node.push_back(x);
+          node.SetStyle(YAML::EmitterStyle::Flow);
+        } else {
+          node = v;
+        }
+      },
+      value);
+  return node;
+}
+
+std::string ParamSpec::range_text() const {
+  if (!lower && !upper) return "";
+  std::string out = lower ? (lower_open ? "(" : "[") + number_text(*lower) : "(-inf";
+  out += ", ";
+  out += upper ? number_text(*upper) + (upper_open ? ")" : "]") : "inf)";
+  return out;
+}
+
+std::string ParamSpec::default_text() const {
+  if (!default_value) return "required";
+  YAML::Emitter out;
+  out << to_yaml(*default_value);
+  return out.c_str();
+}
+
+ParamSpec& ParamSchema::add(ParamSpec spec) {
+  for (const auto& p : params_)
+    if (p.name == spec.name) throw std::logic_error("schema declares '" + spec.name + "' twice");
+  params_.push_back(std::move(spec));
+  return params_.back();
+}
+
+ParamSpec& ParamSchema::real(const std::string& name, const std::string& unit, const std::string& doc) {
+  return add(ParamSpec{name, ParamType::Real, unit, doc});
+}
+ParamSpec& ParamSchema::integer(const std::string& name, const std::string& doc) {
+  return add(ParamSpec{name, ParamType::Integer, "", doc});
+}
+ParamSpec& ParamSchema::boolean(const std::string& name, const std::string& doc) {
+  return add(ParamSpec{name, ParamType::Boolean, "", doc});
+}
+ParamSpec& ParamSchema::string(const std::string& name, const std::string& doc) {
+  return add(ParamSpec{name, ParamType::String, "", doc});
+}
+ParamSpec& ParamSchema::choice(const std::string& name, std::vector<std::string> choices,
+                               const std::string& doc) {
+  ParamSpec spec{name, ParamType::Choice, "", doc};
+  spec.choices = std::move(choices);
+  return add(std::move(spec));
+}
+ParamSpec& ParamSchema::reals(const std::string& name, const std::string& unit, const std::string& doc) {
+  return add(ParamSpec{name, ParamType::RealList, unit, doc});
+}
+
+const ParamSpec* ParamSchema::find(const std::string& name) const {
+  for (const auto& p : params_)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+std::vector<std::string> ParamSchema::names() const {
+  std::vector<std::string> out;
+  for (const auto& p : params_) out.push_back(p.name);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+const ParamValue& ParamSet::get(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) throw std::logic_error("parameter '" + name + "' was never declared");
+  return it->second;
+}
+
+double ParamSet::real(const std::string& name) const { return std::get<double>(get(name)); }
+long ParamSet::integer(const std::string& name) const { return std::get<long>(get(name)); }
+bool ParamSet::boolean(const std::string& name) const { return std::get<bool>(get(name)); }
+const std::string& ParamSet::string(const std::string& name) const {
+  return std::get<std::string>(get(name));
+}
+const std::vector<double>& ParamSet::reals(const std::string& name) const {
+  return std::get<std::vector<double>>(get(name));
+}
+
+SourceLocation ParamSet::where(const std::string& name) const {
+  const auto it = where_.find(name);
+  return it == where_.end() ? SourceLocation{} : it->second;
+}
+
+InputError ParamSet::error(const std::string& name, const std::string& message) const {
+  return InputError(where(name), message);
+}
+
+void ParamSet::set(const std::string& name, ParamValue value, SourceLocation where) {
+  if (!values_.count(name)) order_.push_back(name);
+  values_[name] = std::move(value);
+  where_[name] = std::move(where);
+}
+
+YAML::Node ParamSet::to_yaml() const {
+  YAML::Node node(YAML::NodeType::Map);
+  for (const auto& name : order_) node[name] = frostmpm::to_yaml(values_.at(name));
+  return node;
+}
+
+namespace {
+
+void check_range(const ParamSpec& spec, double v, const ConfigNode& node) {
+  const bool low_bad = spec.lower && (spec.lower_open ? v <= *spec.lower : v < *spec.lower);
+  const bool high_bad = spec.upper && (spec.upper_open ? v >= *spec.upper : v > *spec.upper);
+  if (low_bad || high_bad) {
+    std::string message = "value " + number_text(v) + " is out of range; allowed " + spec.range_text();
+    if (!spec.unit.empty()) message += " " + spec.unit;
+    throw node.error(message);
+  }
+}
+
+ParamValue read_value(const ParamSpec& spec, const ConfigNode& node) {
+  switch (spec.type) {
+    case ParamType::Real: {
+      const double v = node.as_real();
+      check_range(spec, v, node);
+      return v;
+    }
+    case ParamType::Integer: {
+      const long v = node.as_integer();
+      check_range(spec, static_cast<double>(v), node);
+      return v;
+    }
+    case ParamType::Boolean: return node.as_bool();
+    case ParamType::String: return node.as_string();
+    case ParamType::Choice: {
+      const std::string v = node.as_string();
+      for (const auto& c : spec.choices)
+        if (c == v) return v;
+      std::string message = "'" + v + "' is not a valid choice";
+      const std::string hint = closest_match(v, spec.choices);
+      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+      throw node.error(message + " Valid: " + join(spec.choices));
+    }
+    case ParamType::RealList: {
+      std::vector<double> v = node.as_reals();
+      if (spec.list_size && v.size() != spec.list_size)
+        throw node.error("expected a list of " + std::to_string(spec.list_size) + " numbers, got " +
+                         std::to_string(v.size()));
+      for (double x : v) check_range(spec, x, node);
+      return v;
+    }
+  }
+  throw std::logic_error("unhandled parameter type");
+}
+
+}  // namespace
+
+ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
+                      const std::vector<std::string>& also_allowed) {
+  if (!node.is_map() && !node.is_null())
+    throw node.error("expected a mapping of parameters (" + join(schema.names()) + ")");
+  ParamSet set;
+  for (const auto& spec : schema.params()) {
+    if (node.has(spec.name)) {
+      const ConfigNode value = node.child(spec.name);
+      set.set(spec.name, read_value(spec, value), value.where());
+    } else if (spec.default_value) {
+      set.set(spec.name, *spec.default_value, node.where());
+    } else {
+      std::string message = "missing required parameter '" + spec.name + "' (" + spec.doc;
+      if (!spec.unit.empty()) message += ", " + spec.unit;
+      throw node.error(message + ")");
+    }
+  }
+  std::vector<std::string> valid = schema.names();
+  valid.insert(valid.end(), also_allowed.begin(), also_allowed.end());
+  for (const auto& key : also_allowed)
+    if (node.has(key)) (void)node.child(key);  // the caller reads these itself
+  node.finish(valid);
+  return set;
+}
+
+}  // namespace frostmpm

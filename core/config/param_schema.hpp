@@ -1,0 +1,102 @@
+#pragma once
+// Every registered object declares its parameters here: name, type, required or default,
+// allowed range, unit and a one-line doc. The same schema drives validation of the scene,
+// `frostmpm describe` and the generated config reference.
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "frostmpm/config/config_node.hpp"
+
+namespace frostmpm {
+
+enum class ParamType { Real, Integer, Boolean, String, Choice, RealList };
+std::string to_string(ParamType type);
+
+using ParamValue = std::variant<double, long, bool, std::string, std::vector<double>>;
+
+struct ParamSpec {
+  std::string name;
+  ParamType type = ParamType::Real;
+  std::string unit;  ///< "" for dimensionless or not numeric
+  std::string doc;
+  std::optional<ParamValue> default_value;  ///< empty: required
+  std::optional<double> lower, upper;
+  bool lower_open = false, upper_open = false;
+  std::vector<std::string> choices;  ///< for Choice
+  std::size_t list_size = 0;         ///< for RealList; 0 = any length
+
+  bool required() const { return !default_value.has_value(); }
+
+  // Fluent setters used by schema declarations.
+  ParamSpec& defaults_to(ParamValue value) { default_value = std::move(value); return *this; }
+  // Without this, a string literal would silently pick the bool alternative of ParamValue.
+  ParamSpec& defaults_to(const char* text) { default_value = std::string(text); return *this; }
+  ParamSpec& at_least(double v) { lower = v; lower_open = false; return *this; }
+  ParamSpec& above(double v) { lower = v; lower_open = true; return *this; }
+  ParamSpec& at_most(double v) { upper = v; upper_open = false; return *this; }
+  ParamSpec& below(double v) { upper = v; upper_open = true; return *this; }
+  ParamSpec& size(std::size_t n) { list_size = n; return *this; }
+
+  /// "(0, 1]" style text for docs and messages; "" when unbounded.
+  std::string range_text() const;
+  /// Default as YAML text, or "required".
+  std::string default_text() const;
+};
+
+class ParamSchema {
+ public:
+  ParamSpec& real(const std::string& name, const std::string& unit, const std::string& doc);
+  ParamSpec& integer(const std::string& name, const std::string& doc);
+  ParamSpec& boolean(const std::string& name, const std::string& doc);
+  ParamSpec& string(const std::string& name, const std::string& doc);
+  ParamSpec& choice(const std::string& name, std::vector<std::string> choices, const std::string& doc);
+  ParamSpec& reals(const std::string& name, const std::string& unit, const std::string& doc);
+
+  const std::vector<ParamSpec>& params() const { return params_; }
+  const ParamSpec* find(const std::string& name) const;
+  std::vector<std::string> names() const;
+
+ private:
+  ParamSpec& add(ParamSpec spec);
+  std::vector<ParamSpec> params_;
+};
+
+/// Validated parameter values (defaults filled in), each remembering where it came from.
+class ParamSet {
+ public:
+  double real(const std::string& name) const;
+  long integer(const std::string& name) const;
+  bool boolean(const std::string& name) const;
+  const std::string& string(const std::string& name) const;
+  const std::vector<double>& reals(const std::string& name) const;
+  bool has(const std::string& name) const { return values_.count(name) != 0; }
+
+  SourceLocation where(const std::string& name) const;
+  /// Error about one parameter (cross-parameter checks in a model's constructor use this).
+  InputError error(const std::string& name, const std::string& message) const;
+
+  /// The resolved values as YAML, in schema order (for `frostmpm check` and run.json).
+  YAML::Node to_yaml() const;
+
+  void set(const std::string& name, ParamValue value, SourceLocation where);
+
+ private:
+  std::vector<std::string> order_;
+  std::map<std::string, ParamValue> values_;
+  std::map<std::string, SourceLocation> where_;
+  const ParamValue& get(const std::string& name) const;
+};
+
+/// Reads every schema parameter from `node`, checks types and ranges, fills defaults, and
+/// rejects unknown keys (keys listed in `also_allowed` are left for the caller).
+ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
+                      const std::vector<std::string>& also_allowed = {});
+
+YAML::Node to_yaml(const ParamValue& value);
+
+}  // namespace frostmpm

@@ -1,0 +1,62 @@
+#include "frostmpm/plugin/registry.hpp"
+
+namespace frostmpm {
+
+void Registry::add(RegistryEntry entry) {
+  auto& by_name = kinds_[entry.kind];
+  const auto it = by_name.find(entry.name);
+  if (it != by_name.end())
+    throw InputError("duplicate " + entry.kind + " name '" + entry.name + "': registered by " +
+                     it->second.library + " and again by " + entry.library);
+  by_name.emplace(entry.name, std::move(entry));
+}
+
+const RegistryEntry* Registry::find(const std::string& kind, const std::string& name) const {
+  const auto k = kinds_.find(kind);
+  if (k == kinds_.end()) return nullptr;
+  const auto n = k->second.find(name);
+  return n == k->second.end() ? nullptr : &n->second;
+}
+
+const RegistryEntry& Registry::get(const std::string& kind, const std::string& name,
+                                   const SourceLocation& where) const {
+  if (const RegistryEntry* e = find(kind, name)) return *e;
+  const auto valid = names(kind);
+  std::string message = "unknown " + kind + " model '" + name + "'";
+  const std::string hint = closest_match(name, valid);
+  if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+  message += " Registered: " + (valid.empty() ? std::string("(none; is the plugin path right?)") : join(valid));
+  throw InputError(where, message);
+}
+
+std::vector<std::string> Registry::kinds() const {
+  std::vector<std::string> out;
+  for (const auto& [kind, _] : kinds_) out.push_back(kind);
+  return out;
+}
+
+std::vector<std::string> Registry::names(const std::string& kind) const {
+  std::vector<std::string> out;
+  const auto k = kinds_.find(kind);
+  if (k != kinds_.end())
+    for (const auto& [name, _] : k->second) out.push_back(name);
+  return out;
+}
+
+std::vector<const RegistryEntry*> Registry::entries(const std::string& kind) const {
+  std::vector<const RegistryEntry*> out;
+  const auto k = kinds_.find(kind);
+  if (k != kinds_.end())
+    for (const auto& [_, entry] : k->second) out.push_back(&entry);
+  return out;
+}
+
+void Registrar::add_entry(RegistryEntry entry) {
+  entry.library = library_;
+  entry.plugin = plugin_;
+  entry.version = version_;
+  entry.library_handle = handle_;
+  registry_.add(std::move(entry));
+}
+
+}  // namespace frostmpm

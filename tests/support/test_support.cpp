@@ -1,0 +1,65 @@
+#include "test_support.hpp"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+#include "frostmpm/plugin/plugin_loader.hpp"
+
+namespace frostmpm::test {
+
+const Registry& builtin_registry() {
+  static Registry registry = [] {
+    Registry r;
+    PluginLoader loader(r);
+    for (const auto& dir : PluginLoader::default_search_path()) loader.load_directory(dir);
+    return r;
+  }();
+  return registry;
+}
+
+std::string source_dir() { return FROSTMPM_SOURCE_DIR; }
+std::string binary_dir() { return FROSTMPM_BINARY_DIR; }
+std::string frostmpm_exe() { return binary_dir() + "/bin/frostmpm"; }
+
+CommandResult run_command(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) result.output += buffer.data();
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+CommandResult run_frostmpm(const std::string& args) { return run_command(frostmpm_exe() + " " + args); }
+
+TempDir::TempDir() {
+  std::string pattern = (std::filesystem::temp_directory_path() / "frostmpm-test-XXXXXX").string();
+  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  path_ = pattern;
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace frostmpm::test

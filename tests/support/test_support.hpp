@@ -1,0 +1,44 @@
+#pragma once
+// Shared helpers for tests: the registry with the built-in plugins loaded, paths into the
+// source and build trees, and running the frostmpm CLI as a user would.
+#include <string>
+
+#include "frostmpm/plugin/registry.hpp"
+
+namespace frostmpm::test {
+
+/// Registry with every built-in plugin loaded (once per test binary).
+const Registry& builtin_registry();
+
+std::string source_dir();   ///< repository root
+std::string binary_dir();   ///< CMake build folder
+std::string frostmpm_exe(); ///< path of the built `frostmpm` program
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< stdout and stderr together
+};
+/// Runs a shell command, capturing its output (stderr merged into stdout).
+CommandResult run_command(const std::string& command);
+/// Runs `frostmpm <args>`.
+CommandResult run_frostmpm(const std::string& args);
+
+/// A fresh empty temporary folder, removed when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+/// Writes `text` to `path`.
+void write_file(const std::string& path, const std::string& text);
+std::string read_file(const std::string& path);
+
+}  // namespace frostmpm::test
