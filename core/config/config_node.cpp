@@ -1,5 +1,6 @@
 #include "frostmpm/config/config_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -80,9 +81,21 @@ std::optional<ConfigNode> ConfigNode::optional_child(const std::string& key) con
 
 void ConfigNode::finish(const std::vector<std::string>& valid_keys) const {
   if (!node_.IsMap()) return;
+  std::vector<std::string> unread;
+  for (const auto& kv : node_)
+    if (!consumed_->count(kv.first.as<std::string>())) unread.push_back(kv.first.as<std::string>());
+  if (!unread.empty()) reject_unknown(valid_keys);
+  // Keys that are valid but unread are a programming error in the reader, not user input.
+  for (const auto& key : unread)
+    if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end())
+      throw std::logic_error("scene key '" + child_path(key) + "' is valid but was never read");
+}
+
+void ConfigNode::reject_unknown(const std::vector<std::string>& valid_keys) const {
+  if (!node_.IsMap()) return;
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
-    if (consumed_->count(key)) continue;
+    if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end()) continue;
     ConfigNode offending(kv.first, file_, child_path(key));
     std::string message = "unknown key '" + key + "'";
     const std::string hint = closest_match(key, valid_keys);

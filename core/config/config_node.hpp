@@ -38,6 +38,9 @@ class ConfigNode {
   std::vector<std::string> keys() const;
   /// Throws for the first key nobody read, naming the closest entry of `valid_keys`.
   void finish(const std::vector<std::string>& valid_keys) const;
+  /// Throws for the first key not in `valid_keys`, read or not (a typo reported before the
+  /// "missing parameter" it causes).
+  void reject_unknown(const std::vector<std::string>& valid_keys) const;
 
   // ---- sequences ----
   std::vector<ConfigNode> elements() const;

@@ -191,6 +191,9 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
                       const std::vector<std::string>& also_allowed) {
   if (!node.is_map() && !node.is_null())
     throw node.error("expected a mapping of parameters (" + join(schema.names()) + ")");
+  std::vector<std::string> valid = schema.names();
+  valid.insert(valid.end(), also_allowed.begin(), also_allowed.end());
+  node.reject_unknown(valid);
   ParamSet set;
   for (const auto& spec : schema.params()) {
     if (node.has(spec.name)) {
@@ -204,8 +207,6 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
       throw node.error(message + ")");
     }
   }
-  std::vector<std::string> valid = schema.names();
-  valid.insert(valid.end(), also_allowed.begin(), also_allowed.end());
   for (const auto& key : also_allowed)
     if (node.has(key)) (void)node.child(key);  // the caller reads these itself
   node.finish(valid);
