@@ -8,6 +8,7 @@
 
 #include "frostmpm/config/input_error.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
+#include "frostmpm/simulation/simulation.hpp"
 #include "reference.hpp"
 #include "task.hpp"
 
@@ -104,7 +105,13 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir) {
   auto prepared = prepare(o);
   const std::string dir = out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
   OutputDir out(dir);
-  prepared->task->execute(out);
+  try {
+    prepared->task->execute(out);
+  } catch (const NumericalBlowUp& e) {
+    std::cerr << "error: " << e.what() << "; the frames written before it in " << dir
+              << " stay readable\n";
+    return kBlowUpExitCode;
+  }
 
   nlohmann::json summary;
   summary["frostmpm_version"] = FROSTMPM_VERSION;
@@ -115,6 +122,7 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir) {
   for (const auto& p : prepared->loader->loaded())
     summary["plugins"].push_back({{"name", p.name}, {"version", p.version}, {"library", p.file}});
   summary["resolved_scene"] = to_json(prepared->resolved);
+  summary["run"] = to_json(prepared->task->summary());
   summary["wall_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");

@@ -29,6 +29,8 @@ class Task {
   /// The scene as it will run: every section with defaults filled in.
   virtual YAML::Node resolved() const = 0;
   virtual void execute(const OutputDir& out) = 0;
+  /// Task-specific facts for run.json (steps, timings, counters).
+  virtual YAML::Node summary() const { return {}; }
 };
 
 using TaskFactory = std::function<std::unique_ptr<Task>(const TaskContext&)>;
@@ -36,5 +38,6 @@ using TaskFactory = std::function<std::unique_ptr<Task>(const TaskContext&)>;
 const std::map<std::string, TaskFactory>& tasks();
 
 std::unique_ptr<Task> make_freezing_curves_task(const TaskContext& context);
+std::unique_ptr<Task> make_simulation_task(const TaskContext& context);
 
 }  // namespace frostmpm::app

@@ -25,6 +25,11 @@ class ImpedancePermeability final : public RelativePermeabilityModel {
                 std::span<double> dk_r) const override {
     const double ln10 = std::log(10.0);
     for (std::size_t i = 0; i < S_l.size(); ++i) {
+      if (S_l[i] > 1.0) {  // round-off above full saturation: thawed, k_r stays at 1
+        k_r[i] = 1.0;
+        dk_r[i] = 0.0;
+        continue;
+      }
       const double rate = omega_ * porosity[i];
       const double value = std::pow(10.0, -rate * (1.0 - S_l[i]));
       if (value <= floor_) {

@@ -1,0 +1,53 @@
+// `task: simulation` — a material point simulation: the kernel plus the scene's physics.
+#include <sys/resource.h>
+
+#include "frostmpm/simulation/simulation.hpp"
+#include "task.hpp"
+
+namespace frostmpm::app {
+namespace {
+
+class SimulationTask final : public Task {
+ public:
+  explicit SimulationTask(const TaskContext& ctx) : sim_(ctx.registry, ctx.root) {}
+
+  std::vector<std::string> sections() const override { return Simulation::sections(); }
+  YAML::Node resolved() const override { return sim_.resolved(); }
+  void execute(const OutputDir& out) override {
+    const bool progress = sim_.resolved()["output"]["progress"].as<bool>();
+    sim_.run(out, progress);
+  }
+
+  YAML::Node summary() const override {
+    YAML::Node s;
+    const auto& st = sim_.statistics();
+    s["steps"] = st.steps;
+    s["simulated_seconds"] = sim_.time();
+    s["dt"]["min"] = st.dt_min;
+    s["dt"]["max"] = st.dt_max;
+    s["dt"]["mean"] = st.steps ? st.dt_sum / double(st.steps) : 0.0;
+    for (const auto& [name, seconds] : st.stage_seconds) s["stage_wall_seconds"][name] = seconds;
+    s["physics"] = sim_.physics_names();
+    for (const auto& physics : sim_.physics())
+      for (const auto& [key, value] : physics->statistics()) s["counters"][key] = value;
+    s["particles"] = static_cast<long>(sim_.particles().size());
+    s["grid_nodes"] = static_cast<long>(sim_.grid().node_count());
+    s["particle_fields"] = sim_.particles().field_names();
+    s["particle_field_bytes"] = static_cast<long>(sim_.particles().bytes());
+    struct rusage usage {};
+    getrusage(RUSAGE_SELF, &usage);
+    s["peak_memory_mib"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
+    return s;
+  }
+
+ private:
+  Simulation sim_;
+};
+
+}  // namespace
+
+std::unique_ptr<Task> make_simulation_task(const TaskContext& context) {
+  return std::make_unique<SimulationTask>(context);
+}
+
+}  // namespace frostmpm::app

@@ -1,0 +1,450 @@
+// The project's only Trilinos-facing translation unit (see sparse_system.hpp).
+#include "frostmpm/linalg/sparse_system.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include <mpi.h>
+
+#include <Kokkos_Core.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
+#include <Teuchos_ParameterList.hpp>
+#include <Teuchos_RCP.hpp>
+#include <Tpetra_CrsGraph.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_Vector.hpp>
+
+// The solver factory hands out solver managers that libbelostpetra already instantiated for
+// Tpetra, so this file does not compile the (large) Belos solver templates itself.
+#include <BelosLinearProblem.hpp>
+#include <BelosSolverFactory_Tpetra.hpp>
+#include <BelosTpetraAdapter.hpp>
+
+#include <Ifpack2_Factory.hpp>
+#include <Ifpack2_Preconditioner.hpp>
+
+// Trilinos 13.x's Teuchos_StandardParameterEntryValidators.hpp is not valid C++20: it declares
+// a constructor with a template-id, `AbstractArrayValidator<ValidatorType, EntryType>();`
+// (ill-formed since C++20, CWG 2237; GCC 12 rejects it; later Teuchos writes
+// `AbstractArrayValidator();`). Belos and Ifpack2 above do not include that header; MueLu
+// includes it (via MueLu_ParameterListAcceptor.hpp) without using it in what we instantiate, so
+// pre-defining its include guard skips it. Anything that did need it would fail to compile
+// here, not misbehave. Drop this once Trilinos is upgraded.
+#include <Trilinos_version.h>
+#if __cplusplus > 201703L && TRILINOS_MAJOR_VERSION <= 13 && \
+    !defined(TEUCHOS_STANDARD_PARAMETER_ENTRY_VALIDATORS_H)
+#define TEUCHOS_STANDARD_PARAMETER_ENTRY_VALIDATORS_H
+#endif
+#include <MueLu_CreateTpetraPreconditioner.hpp>
+#include <MueLu_TpetraOperator.hpp>
+
+#include "frostmpm/linalg/mpi_session.hpp"
+
+namespace frostmpm {
+namespace {
+
+using Map = Tpetra::Map<>;
+using LO = Map::local_ordinal_type;
+using GO = Map::global_ordinal_type;
+using NT = Map::node_type;
+using SC = double;
+using Graph = Tpetra::CrsGraph<LO, GO, NT>;
+using Matrix = Tpetra::CrsMatrix<SC, LO, GO, NT>;
+using RowMatrix = Tpetra::RowMatrix<SC, LO, GO, NT>;
+using Vector = Tpetra::Vector<SC, LO, GO, NT>;
+using MV = Tpetra::MultiVector<SC, LO, GO, NT>;
+using OP = Tpetra::Operator<SC, LO, GO, NT>;
+using Problem = Belos::LinearProblem<SC, MV, OP>;
+using Ifpack2Prec = Ifpack2::Preconditioner<SC, LO, GO, NT>;
+using MueLuPrec = MueLu::TpetraOperator<SC, LO, GO, NT>;
+using Teuchos::RCP;
+using Teuchos::rcp;
+
+static_assert(std::is_same_v<LO, int>, "column indices are passed as int");
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Kokkos (needed by Tpetra) initialized once, on first use; finalized at exit only if we
+/// initialized it. Constructed after MPI's lazy owner, so it is destroyed before MPI_Finalize.
+struct KokkosRuntime {
+  bool owns = false;
+  KokkosRuntime() {
+    if (!Kokkos::is_initialized()) {
+      Kokkos::initialize();
+      owns = true;
+    }
+  }
+  ~KokkosRuntime() {
+    if (owns && Kokkos::is_initialized()) Kokkos::finalize();
+  }
+  KokkosRuntime(const KokkosRuntime&) = delete;
+  KokkosRuntime& operator=(const KokkosRuntime&) = delete;
+};
+
+void ensure_runtime() {
+  ensure_mpi_initialized();
+  static KokkosRuntime kokkos;
+  (void)kokkos;
+}
+
+void validate_options(const SolverOptions& o) {
+  if (o.method != "cg" && o.method != "gmres") {
+    throw std::invalid_argument("SparseSystem: unknown solver method '" + o.method +
+                                "' (expected cg or gmres)");
+  }
+  const auto& p = o.preconditioner;
+  if (p != "none" && p != "jacobi" && p != "ilu" && p != "multigrid") {
+    throw std::invalid_argument("SparseSystem: unknown preconditioner '" + p +
+                                "' (expected none, jacobi, ilu or multigrid)");
+  }
+  if (!(o.tolerance > 0.0) || !std::isfinite(o.tolerance)) {
+    throw std::invalid_argument("SparseSystem: tolerance must be positive and finite");
+  }
+  if (o.max_iterations <= 0) {
+    throw std::invalid_argument("SparseSystem: max_iterations must be positive");
+  }
+  if (o.gmres_restart <= 0) {
+    throw std::invalid_argument("SparseSystem: gmres_restart must be positive");
+  }
+}
+
+}  // namespace
+
+struct SparseSystem::Impl {
+  // ---- pattern and values (host copy, order of the caller's column_indices) ----
+  std::size_t n = 0;
+  std::vector<std::size_t> offsets;
+  std::vector<int> columns;         ///< as given
+  std::vector<LO> sorted_columns;   ///< per row, ascending
+  std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
+  std::vector<double> values;
+  std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
+  bool values_dirty = true;
+  SolverOptions options;
+
+  // ---- Trilinos objects (absent when n == 0) ----
+  RCP<const Teuchos::Comm<int>> comm;
+  RCP<const Map> map;
+  RCP<Matrix> matrix;
+  RCP<Vector> b, x, r;
+  RCP<Problem> problem;
+  RCP<Ifpack2Prec> ifpack2;   ///< jacobi / ilu
+  RCP<MueLuPrec> muelu;       ///< multigrid
+  bool have_preconditioner = false;
+
+  Impl(std::vector<std::size_t> row_offsets, std::vector<int> column_indices, SolverOptions opts)
+      : offsets(std::move(row_offsets)), columns(std::move(column_indices)),
+        options(std::move(opts)) {
+    validate_options(options);
+    validate_and_sort_pattern();
+    values.assign(columns.size(), 0.0);
+    if (n > 0) build_trilinos_objects();
+  }
+
+  void validate_and_sort_pattern() {
+    if (offsets.empty()) {
+      throw std::invalid_argument("SparseSystem: row_offsets needs rows+1 entries (got none)");
+    }
+    n = offsets.size() - 1;
+    if (n > static_cast<std::size_t>(std::numeric_limits<LO>::max())) {
+      throw std::invalid_argument("SparseSystem: too many rows for int column indices");
+    }
+    if (offsets.front() != 0) {
+      throw std::invalid_argument("SparseSystem: row_offsets must start at 0");
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (offsets[i + 1] < offsets[i]) {
+        throw std::invalid_argument("SparseSystem: row_offsets must be non-decreasing (row " +
+                                    std::to_string(i) + ")");
+      }
+    }
+    if (offsets.back() != columns.size()) {
+      throw std::invalid_argument("SparseSystem: row_offsets.back() = " +
+                                  std::to_string(offsets.back()) + " but there are " +
+                                  std::to_string(columns.size()) + " column indices");
+    }
+    order.resize(columns.size());
+    sorted_columns.resize(columns.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t begin = offsets[i], end = offsets[i + 1];
+      for (std::size_t k = begin; k < end; ++k) {
+        if (columns[k] < 0 || static_cast<std::size_t>(columns[k]) >= n) {
+          throw std::invalid_argument("SparseSystem: column index " + std::to_string(columns[k]) +
+                                      " in row " + std::to_string(i) + " is outside [0, " +
+                                      std::to_string(n) + ")");
+        }
+      }
+      std::iota(order.begin() + begin, order.begin() + end, begin);
+      std::sort(order.begin() + begin, order.begin() + end,
+                [&](std::size_t a, std::size_t c) { return columns[a] < columns[c]; });
+      for (std::size_t k = begin; k < end; ++k) {
+        sorted_columns[k] = columns[order[k]];
+        if (k > begin && sorted_columns[k] == sorted_columns[k - 1]) {
+          throw std::invalid_argument("SparseSystem: column " + std::to_string(sorted_columns[k]) +
+                                      " appears twice in row " + std::to_string(i));
+        }
+      }
+    }
+  }
+
+  void build_trilinos_objects() {
+    ensure_runtime();
+    // Serial data for now: each rank holds the whole system on its own communicator.
+    comm = rcp(new Teuchos::MpiComm<int>(MPI_COMM_SELF));
+    map = rcp(new Map(static_cast<Tpetra::global_size_t>(n), GO{0}, comm));
+
+    std::vector<std::size_t> counts(n);
+    for (std::size_t i = 0; i < n; ++i) counts[i] = offsets[i + 1] - offsets[i];
+    // Column map = row map: local column index == global column index on one process.
+    auto graph = rcp(new Graph(map, map, Teuchos::ArrayView<const std::size_t>(counts)));
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto count = static_cast<LO>(counts[i]);
+      if (count > 0) {
+        graph->insertLocalIndices(static_cast<LO>(i), count, sorted_columns.data() + offsets[i]);
+      }
+    }
+    graph->fillComplete();
+    matrix = rcp(new Matrix(RCP<const Graph>(graph)));
+    matrix->fillComplete();  // all zeros; allocates the value array in its final layout
+    map_storage_positions();
+
+    b = rcp(new Vector(map));
+    x = rcp(new Vector(map));
+    r = rcp(new Vector(map));
+    problem = rcp(new Problem(matrix, x, b));
+  }
+
+  /// Where each of the caller's entries lives in the matrix's value array (filled once the
+  /// graph is complete; Tpetra keeps each row's columns sorted, as in sorted_columns).
+  void map_storage_positions() {
+    const auto local_graph = matrix->getCrsGraph()->getLocalGraphHost();
+    storage_position.resize(columns.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      auto pos = static_cast<std::size_t>(local_graph.row_map(i));
+      const auto row_end = static_cast<std::size_t>(local_graph.row_map(i + 1));
+      for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        while (pos < row_end && local_graph.entries(pos) < sorted_columns[k]) ++pos;
+        if (pos == row_end || local_graph.entries(pos) != sorted_columns[k]) {
+          throw std::logic_error("SparseSystem: Tpetra graph lost entry (" + std::to_string(i) +
+                                 ", " + std::to_string(sorted_columns[k]) + ")");
+        }
+        storage_position[order[k]] = pos;
+      }
+    }
+  }
+
+  /// Copies the host values into the Tpetra matrix (graph unchanged): one pass over the value
+  /// array instead of per-row index searches.
+  void upload_values() {
+    if (matrix->isFillComplete()) matrix->resumeFill();
+    {
+      const auto device_values = matrix->getLocalValuesView();
+      const auto host_values = Kokkos::create_mirror_view(device_values);
+      for (std::size_t k = 0; k < values.size(); ++k) host_values(storage_position[k]) = values[k];
+      Kokkos::deep_copy(device_values, host_values);
+    }
+    matrix->fillComplete();
+    values_dirty = false;
+  }
+
+  void build_preconditioner() {
+    const auto& kind = options.preconditioner;
+    if (kind == "jacobi" || kind == "ilu") {
+      if (ifpack2.is_null()) {
+        // initialize() depends on the graph only, so it runs once; compute() reads the values.
+        ifpack2 = Ifpack2::Factory::create<RowMatrix>(kind == "jacobi" ? "RELAXATION" : "RILUK",
+                                                      RCP<const RowMatrix>(matrix));
+        Teuchos::ParameterList params;
+        if (kind == "jacobi") {
+          params.set("relaxation: type", "Jacobi");
+          params.set("relaxation: sweeps", 1);
+          params.set("relaxation: damping factor", 1.0);
+        } else {
+          params.set("fact: iluk level-of-fill", 0);
+        }
+        ifpack2->setParameters(params);
+        ifpack2->initialize();
+      }
+      ifpack2->compute();
+      problem->setRightPrec(ifpack2);
+    } else if (kind == "multigrid") {
+      Teuchos::ParameterList params;
+      params.set("verbosity", "none");
+      params.set("multigrid algorithm", "sa");
+      params.set("coarse: max size", 200);
+      // Symmetric smoothing keeps the V-cycle symmetric, as CG needs.
+      params.set("smoother: type", "RELAXATION");
+      params.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
+      params.sublist("smoother: params").set("relaxation: sweeps", 1);
+      // A relaxation coarse solve (not a direct solver) keeps this MPI- and build-agnostic.
+      params.set("coarse: type", "RELAXATION");
+      params.sublist("coarse: params").set("relaxation: type", "Symmetric Gauss-Seidel");
+      params.sublist("coarse: params").set("relaxation: sweeps", 4);
+      muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(matrix), params);
+      problem->setRightPrec(muelu);
+    }
+    have_preconditioner = true;
+  }
+
+  double relative_residual(double b_norm) {
+    matrix->apply(*x, *r);
+    r->update(1.0, *b, -1.0);  // r = b - A x
+    return r->norm2() / b_norm;
+  }
+
+  /// One Belos run from the current x; returns the iterations it took.
+  int run_krylov(int max_iterations) {
+    auto params = rcp(new Teuchos::ParameterList);
+    params->set("Convergence Tolerance", options.tolerance);
+    params->set("Maximum Iterations", max_iterations);
+    params->set("Implicit Residual Scaling", "Norm of RHS");
+    params->set("Verbosity", static_cast<int>(Belos::Errors));
+    if (!problem->setProblem(x, b)) {
+      throw std::runtime_error("SparseSystem: Belos could not set up the linear problem");
+    }
+    if (options.method == "gmres") {
+      const int restart = std::min(options.gmres_restart, max_iterations);
+      params->set("Num Blocks", restart);
+      params->set("Maximum Restarts", max_iterations / restart + 1);
+      params->set("Explicit Residual Scaling", "Norm of RHS");
+    }
+    Belos::SolverFactory<SC, MV, OP> factory;
+    const RCP<Belos::SolverManager<SC, MV, OP>> solver =
+        factory.create(options.method == "cg" ? "PSEUDOBLOCK CG" : "PSEUDOBLOCK GMRES", params);
+    solver->setProblem(problem);
+    try {
+      solver->solve();
+    } catch (const std::exception& e) {
+      throw std::runtime_error("SparseSystem: " + options.method + " solve failed: " + e.what());
+    }
+    return solver->getNumIters();
+  }
+
+  SolveStats solve(std::span<const double> rhs, std::span<double> x_io, bool rebuild) {
+    if (rhs.size() != n || x_io.size() != n) {
+      throw std::invalid_argument("SparseSystem::solve: rhs and x need " + std::to_string(n) +
+                                  " entries (got " + std::to_string(rhs.size()) + " and " +
+                                  std::to_string(x_io.size()) + ")");
+    }
+    SolveStats stats;
+    if (n == 0) {
+      stats.converged = true;
+      return stats;
+    }
+
+    const auto setup_start = Clock::now();
+    if (values_dirty) upload_values();
+    if (options.preconditioner != "none") {
+      if (rebuild || !have_preconditioner) {
+        build_preconditioner();
+      } else {
+        stats.preconditioner_reused = true;
+      }
+    }
+    stats.setup_seconds = seconds_since(setup_start);
+
+    const auto solve_start = Clock::now();
+    {
+      auto bv = b->getLocalViewHost(Tpetra::Access::OverwriteAll);
+      auto xv = x->getLocalViewHost(Tpetra::Access::OverwriteAll);
+      for (std::size_t i = 0; i < n; ++i) {
+        bv(i, 0) = rhs[i];
+        xv(i, 0) = x_io[i];
+      }
+    }
+    const double b_norm = b->norm2();
+    if (b_norm == 0.0) {
+      std::fill(x_io.begin(), x_io.end(), 0.0);  // A x = 0 has the solution 0
+      stats.converged = true;
+      stats.solve_seconds = seconds_since(solve_start);
+      return stats;
+    }
+    if (!std::isfinite(b_norm)) {
+      throw std::invalid_argument("SparseSystem::solve: rhs contains inf or NaN");
+    }
+
+    // Belos judges convergence on its recursively updated residual; we judge it on the true
+    // residual and, if rounding left it above the tolerance, continue from the current x.
+    double rel = relative_residual(b_norm);
+    for (int pass = 0; pass < 4 && rel > options.tolerance; ++pass) {
+      const int remaining = options.max_iterations - stats.iterations;
+      if (remaining <= 0) break;
+      const int its = run_krylov(remaining);
+      stats.iterations += its;
+      rel = relative_residual(b_norm);
+      if (its == 0) break;  // no progress possible
+    }
+    stats.relative_residual = rel;
+    stats.converged = std::isfinite(rel) && rel <= options.tolerance;
+    {
+      auto xv = x->getLocalViewHost(Tpetra::Access::ReadOnly);
+      for (std::size_t i = 0; i < n; ++i) x_io[i] = xv(i, 0);
+    }
+    stats.solve_seconds = seconds_since(solve_start);
+    return stats;
+  }
+
+  void add_to_entry(std::size_t row, std::size_t col, double delta) {
+    if (row >= n || col >= n) {
+      throw std::out_of_range("SparseSystem::add_to_entry: (" + std::to_string(row) + ", " +
+                              std::to_string(col) + ") is outside the " + std::to_string(n) +
+                              "x" + std::to_string(n) + " matrix");
+    }
+    const auto first = sorted_columns.begin() + static_cast<std::ptrdiff_t>(offsets[row]);
+    const auto last = sorted_columns.begin() + static_cast<std::ptrdiff_t>(offsets[row + 1]);
+    const auto it = std::lower_bound(first, last, static_cast<LO>(col));
+    if (it == last || *it != static_cast<LO>(col)) {
+      throw std::out_of_range("SparseSystem::add_to_entry: (" + std::to_string(row) + ", " +
+                              std::to_string(col) + ") is not in the sparsity pattern");
+    }
+    values[order[static_cast<std::size_t>(it - sorted_columns.begin())]] += delta;
+    values_dirty = true;
+  }
+};
+
+SparseSystem::SparseSystem(std::vector<std::size_t> row_offsets, std::vector<int> column_indices,
+                           SolverOptions options)
+    : impl_(std::make_unique<Impl>(std::move(row_offsets), std::move(column_indices),
+                                   std::move(options))) {}
+
+SparseSystem::~SparseSystem() = default;
+SparseSystem::SparseSystem(SparseSystem&&) noexcept = default;
+SparseSystem& SparseSystem::operator=(SparseSystem&&) noexcept = default;
+
+std::size_t SparseSystem::rows() const { return impl_->n; }
+std::size_t SparseSystem::nonzeros() const { return impl_->columns.size(); }
+const SolverOptions& SparseSystem::options() const { return impl_->options; }
+
+void SparseSystem::set_values(std::span<const double> values) {
+  if (values.size() != impl_->values.size()) {
+    throw std::invalid_argument("SparseSystem::set_values: expected " +
+                                std::to_string(impl_->values.size()) + " values, got " +
+                                std::to_string(values.size()));
+  }
+  std::copy(values.begin(), values.end(), impl_->values.begin());
+  impl_->values_dirty = true;
+}
+
+std::span<const double> SparseSystem::values() const { return impl_->values; }
+
+void SparseSystem::add_to_entry(std::size_t row, std::size_t col, double delta) {
+  impl_->add_to_entry(row, col, delta);
+}
+
+SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x,
+                               bool rebuild_preconditioner) {
+  return impl_->solve(rhs, x, rebuild_preconditioner);
+}
+
+}  // namespace frostmpm

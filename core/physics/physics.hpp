@@ -1,0 +1,57 @@
+#pragma once
+// A physics plugin contributes coupled equations to the step: it declares the particle fields
+// it needs, the material parameters and model slots it reads, the boundary-condition types it
+// owns, and the ordered stages it adds to the step. The kernel never names a physical model.
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "frostmpm/config/param_schema.hpp"
+
+namespace frostmpm {
+
+class Simulation;
+
+/// A model a physics needs from every material, e.g. {"sfcc", "sfcc", required}.
+struct ModelSlot {
+  std::string key;   ///< key inside the material section
+  std::string kind;  ///< registry kind
+  bool required = true;
+};
+
+/// One stage of the step; the scheduler times each by name for run.json.
+struct Stage {
+  std::string name;
+  std::function<void()> run;
+};
+
+class Physics {
+ public:
+  static constexpr const char* kKind = "physics";
+  virtual ~Physics();
+
+  /// Material-level parameters this physics reads (keys shared with other physics are fine
+  /// when their specs agree).
+  virtual ParamSchema material_schema() const = 0;
+  virtual std::vector<ModelSlot> material_models() const = 0;
+  /// Boundary-condition `type:` names this physics owns.
+  virtual std::vector<std::string> boundary_types() const = 0;
+
+  /// Called once after particles exist: declare fields, read materials and boundary
+  /// conditions from `sim`, validate everything; stages() is valid afterwards.
+  virtual void setup(Simulation& sim) = 0;
+  virtual std::vector<Stage> stages() = 0;
+
+  /// Called once before the first output, after initial values are set: bring derived
+  /// fields (e.g. saturation from temperature) in line with the initial state.
+  virtual void initialize() {}
+  /// Largest stable time step for the current state (infinity when unconditionally stable).
+  virtual double stable_time_step() const { return std::numeric_limits<double>::infinity(); }
+  /// Called before the stages of a step run, with the step's dt.
+  virtual void begin_step(double /*time*/, double /*dt*/) {}
+  /// Counters for run.json (e.g. linear iterations); keys are free-form.
+  virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
+};
+
+}  // namespace frostmpm

@@ -1,0 +1,68 @@
+#pragma once
+// A scalar function of time t (seconds) for boundary conditions and sources. In a scene it is
+// one of
+//   5.0                                              a constant
+//   {table: [[t0, v0], [t1, v1], ...],               piecewise, times strictly increasing;
+//    interpolation: linear | step,                   (default linear; step holds v_i on [t_i, t_i+1))
+//    extrapolation: hold | error}                    (default hold: end values outside the table)
+//   {expression: "5 + 2*sin(2*pi*t/86400)"}          see expression.hpp for the syntax
+// It is read and checked once; evaluation is cheap and allocation-free, and copies share one
+// immutable implementation (safe to evaluate from several threads).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "frostmpm/config/config_node.hpp"
+#include "frostmpm/scene/expression.hpp"
+
+namespace frostmpm {
+
+class TimeFunction {
+ public:
+  enum class Kind { Constant, Table, Expression };
+  enum class Interpolation { Linear, Step };
+  enum class Extrapolation { Hold, Error };
+
+  /// The constant 0.
+  TimeFunction() = default;
+
+  static TimeFunction constant(double v);
+  /// A table from code; throws InputError for empty, mismatched or non-increasing times.
+  static TimeFunction table(std::vector<double> times, std::vector<double> values,
+                            Interpolation interpolation = Interpolation::Linear,
+                            Extrapolation extrapolation = Extrapolation::Hold);
+  /// An expression of t from code; throws ExpressionError when malformed.
+  static TimeFunction expression(const std::string& text);
+
+  /// Reads any of the three forms; consumes the node's keys and calls finish(). Every problem
+  /// is an InputError naming the YAML path and line.
+  static TimeFunction read(const ConfigNode& node);
+
+  /// Value at time t. With `extrapolation: error`, a t outside the table is an InputError
+  /// pointing at the table in the scene.
+  double operator()(double t) const { return kind_ == Kind::Constant ? value_ : evaluate(t); }
+
+  Kind kind() const { return kind_; }
+  /// True when the value never depends on t (a constant, an expression without t, a table of
+  /// equal values that holds outside its range).
+  bool is_constant() const;
+  /// One-line summary: "5", "table(4 rows, linear)", "expression: 5+2*sin(2*pi*t/86400)".
+  std::string describe() const;
+  /// The resolved form, as it would be written in a scene.
+  YAML::Node to_yaml() const;
+
+  /// The accepted YAML forms, for error messages and documentation.
+  static std::string forms_help();
+
+ private:
+  struct Impl;
+  Kind kind_ = Kind::Constant;
+  double value_ = 0;                  ///< the constant, for Kind::Constant
+  std::shared_ptr<const Impl> impl_;  ///< table or expression, shared between copies
+
+  double evaluate(double t) const;
+};
+
+}  // namespace frostmpm

@@ -1,0 +1,98 @@
+#include "frostmpm/shape/shape_function.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace frostmpm {
+
+const std::vector<std::string>& shape_kind_names() {
+  static const std::vector<std::string> names = {"linear", "gimp", "cubic_bspline"};
+  return names;
+}
+
+ShapeKind parse_shape_kind(const std::string& name) {
+  if (name == "linear") return ShapeKind::Linear;
+  if (name == "gimp") return ShapeKind::Gimp;
+  if (name == "cubic_bspline") return ShapeKind::CubicBSpline;
+  throw std::invalid_argument("unknown shape function '" + name + "'");
+}
+
+std::string to_string(ShapeKind kind) { return shape_kind_names()[static_cast<int>(kind)]; }
+
+namespace {
+
+// uGIMP (Bardenhagen & Kober 2004; paper Eq. 58 with a linear grid basis and a hat-shaped
+// particle characteristic function): r = distance to node in cell units, lp = half-width.
+inline void gimp(double r, double lp, double& s, double& ds) {
+  const double a = std::abs(r);
+  const double sign = r < 0 ? -1.0 : 1.0;
+  if (a >= 1.0 + lp) {
+    s = ds = 0.0;
+  } else if (a > 1.0 - lp) {
+    const double t = 1.0 + lp - a;
+    s = t * t / (4.0 * lp);
+    ds = -sign * t / (2.0 * lp);
+  } else if (a > lp) {
+    s = 1.0 - a;
+    ds = -sign;
+  } else {
+    s = 1.0 - (r * r + lp * lp) / (2.0 * lp);
+    ds = -r / lp;
+  }
+}
+
+inline void bspline(double r, double& s, double& ds) {
+  const double a = std::abs(r);
+  const double sign = r < 0 ? -1.0 : 1.0;
+  if (a >= 2.0) {
+    s = ds = 0.0;
+  } else if (a >= 1.0) {
+    const double t = 2.0 - a;
+    s = t * t * t / 6.0;
+    ds = -sign * 0.5 * t * t;
+  } else {
+    s = 2.0 / 3.0 - a * a + 0.5 * a * a * a;
+    ds = sign * (-2.0 * a + 1.5 * a * a);
+  }
+}
+
+}  // namespace
+
+int shape_1d(ShapeKind kind, double xi, double h, double half_size, double* weight, double* gradient) {
+  const double inv_h = 1.0 / h;
+  switch (kind) {
+    case ShapeKind::Linear: {
+      const int base = static_cast<int>(std::floor(xi));
+      const double f = xi - base;
+      weight[0] = 1.0 - f;
+      weight[1] = f;
+      gradient[0] = -inv_h;
+      gradient[1] = inv_h;
+      return base;
+    }
+    case ShapeKind::Gimp: {
+      // Support of width 3 centred on the nearest node.
+      const int base = static_cast<int>(std::floor(xi + 0.5)) - 1;
+      for (int k = 0; k < 3; ++k) {
+        double s, ds;
+        gimp(xi - (base + k), half_size, s, ds);
+        weight[k] = s;
+        gradient[k] = ds * inv_h;
+      }
+      return base;
+    }
+    case ShapeKind::CubicBSpline: {
+      const int base = static_cast<int>(std::floor(xi)) - 1;
+      for (int k = 0; k < 4; ++k) {
+        double s, ds;
+        bspline(xi - (base + k), s, ds);
+        weight[k] = s;
+        gradient[k] = ds * inv_h;
+      }
+      return base;
+    }
+  }
+  return 0;
+}
+
+}  // namespace frostmpm

@@ -1,0 +1,74 @@
+#include "frostmpm/shape/stencil_cache.hpp"
+
+#include <algorithm>
+
+namespace frostmpm {
+
+template <int Dim>
+long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const double> positions,
+                               std::span<const double> half_sizes) {
+  const std::size_t n = positions.size() / Dim;
+  const std::size_t K = static_cast<std::size_t>(per_particle_);
+  topology_changed_ = n != particles_;
+  particles_ = n;
+  node_.resize(n * K);
+  weight_.resize(n * K);
+  gradient_.resize(n * K * Dim);
+  long outside = -1;
+
+#pragma omp parallel for schedule(static)
+  for (std::size_t p = 0; p < n; ++p) {
+    std::array<std::array<double, 4>, Dim> w{}, g{};
+    std::array<int, Dim> base{};
+    bool inside = true;
+    for (int d = 0; d < Dim; ++d) {
+      const double h = grid.spacing[d];
+      const double xi = (positions[p * Dim + d] - grid.origin[d]) / h;
+      base[d] = shape_1d(kind_, xi, h, half_sizes[p * Dim + d] / h, w[d].data(), g[d].data());
+      // A support node past the grid is harmless when its weight is zero (GIMP particles at
+      // the domain edge); it is then pointed at a valid node.
+      for (int k = 0; k < width_; ++k) {
+        const int node = base[d] + k;
+        if (node >= -grid.ghost_layers && node <= grid.cells[d] + grid.ghost_layers) continue;
+        if (w[d][k] != 0.0 || g[d][k] != 0.0) inside = false;
+      }
+    }
+    if (!inside) {
+#pragma omp critical
+      outside = outside < 0 ? static_cast<long>(p) : std::min(outside, static_cast<long>(p));
+      std::fill_n(weight_.begin() + p * K, K, 0.0);
+      std::fill_n(gradient_.begin() + p * K * Dim, K * Dim, 0.0);
+      std::fill_n(node_.begin() + p * K, K, 0u);
+      continue;
+    }
+    // Tensor product over the width^Dim support nodes.
+    for (std::size_t k = 0; k < K; ++k) {
+      std::size_t rest = k;
+      std::array<int, Dim> offset{}, ijk{};
+      for (int d = 0; d < Dim; ++d) {
+        offset[d] = static_cast<int>(rest % width_);
+        rest /= width_;
+        ijk[d] = std::clamp(base[d] + offset[d], -grid.ghost_layers, grid.cells[d] + grid.ghost_layers);
+      }
+      const std::uint32_t node = static_cast<std::uint32_t>(grid.node_index(ijk));
+      if (node_[p * K + k] != node) topology_changed_ = true;
+      node_[p * K + k] = node;
+      double weight = 1.0;
+      for (int d = 0; d < Dim; ++d) weight *= w[d][offset[d]];
+      weight_[p * K + k] = weight;
+      for (int d = 0; d < Dim; ++d) {
+        double grad = g[d][offset[d]];
+        for (int e = 0; e < Dim; ++e)
+          if (e != d) grad *= w[e][offset[e]];
+        gradient_[(p * K + k) * Dim + d] = grad;
+      }
+    }
+  }
+  ++version_;
+  return outside;
+}
+
+template class StencilCache<2>;
+template class StencilCache<3>;
+
+}  // namespace frostmpm

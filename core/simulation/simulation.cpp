@@ -1,0 +1,571 @@
+#include "frostmpm/simulation/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/io/particle_field_writer.hpp"
+#include "frostmpm/scene/region.hpp"
+
+namespace frostmpm {
+
+namespace {
+
+std::array<double, kDim> read_point(const ConfigNode& node) {
+  const auto v = node.as_reals();
+  if (v.size() != kDim) throw node.error("expected a point with " + std::to_string(kDim) + " coordinates");
+  return {v[0], v[1]};
+}
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Probes: what metrics.csv records over time.
+
+struct Simulation::Probe {
+  std::string name, type, field;
+  std::vector<std::string> fields;
+  std::array<double, kDim> point{}, from{}, to{};
+  double value = 0;
+};
+
+struct Simulation::RegionInit {
+  ParticleRange range;
+  std::vector<std::pair<std::string, double>> values;
+  std::unique_ptr<ConfigNode> node;  ///< `initial:` section, checked once fields exist
+};
+
+std::vector<std::string> Simulation::sections() {
+  return {"grid", "time", "physics", "materials", "regions", "boundary_conditions", "output", "probes"};
+}
+
+Simulation::Simulation(const Registry& registry, const ConfigNode& root) : registry_(registry) {
+  resolved_ = YAML::Node(YAML::NodeType::Map);
+  read_grid(root.child("grid"));
+  read_time(root.child("time"));
+  read_physics(root.child("physics"));
+  read_materials(root.child("materials"));
+  read_regions(root.child("regions"));
+  if (auto bcs = root.optional_child("boundary_conditions")) read_boundary_conditions(*bcs);
+  else resolved_["boundary_conditions"] = YAML::Node(YAML::NodeType::Sequence);
+  for (auto& physics : physics_) physics->setup(*this);
+  for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
+  for (auto& physics : physics_)
+    for (auto& stage : physics->stages()) stages_.push_back(std::move(stage));
+  apply_initial_values();
+  read_output(root.child("output"));
+  const auto probes = root.optional_child("probes");
+  read_probes(probes ? &*probes : nullptr);
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::read_grid(const ConfigNode& node) {
+  ParamSchema s;
+  s.reals("origin", "m", "lower-left corner of the grid").size(kDim).defaults_to(std::vector<double>(kDim, 0.0));
+  s.reals("cells", "-", "number of cells along each axis").size(kDim).at_least(1);
+  s.reals("cell_size", "m", "cell size: one value (square cells) or one per axis").above(0);
+  s.choice("shape_function", shape_kind_names(), "MPM shape functions").defaults_to("gimp");
+  s.integer("particles_per_cell", "particles per cell along each axis").defaults_to(2L).at_least(1).at_most(8);
+  const ParamSet p = parse_params(s, node);
+  const auto& cells = p.reals("cells");
+  const auto& h = p.reals("cell_size");
+  if (h.size() != 1 && h.size() != kDim)
+    throw p.error("cell_size", "give one cell size or one per axis (" + std::to_string(kDim) + ")");
+  for (int d = 0; d < kDim; ++d) {
+    if (cells[d] != std::floor(cells[d])) throw p.error("cells", "cell counts must be whole numbers");
+    grid_.origin[d] = p.reals("origin")[d];
+    grid_.cells[d] = static_cast<int>(cells[d]);
+    grid_.spacing[d] = h.size() == 1 ? h[0] : h[d];
+  }
+  if (grid_.node_count() > 50'000'000) throw p.error("cells", "grid too large (over 50 million nodes)");
+  shape_ = parse_shape_kind(p.string("shape_function"));
+  grid_.ghost_layers = ghost_layers(shape_);
+  stencil_.configure(shape_);
+  resolved_["grid"] = p.to_yaml();
+}
+
+void Simulation::read_time(const ConfigNode& node) {
+  ParamSchema s;
+  s.real("end", "s", "simulated end time").above(0);
+  s.real("dt", "s", "fixed time step; 0 = automatic from the physics' stability limits").defaults_to(0.0).at_least(0);
+  s.real("dt_max", "s", "upper bound on an automatic step; 0 = none").defaults_to(0.0).at_least(0);
+  const ParamSet p = parse_params(s, node);
+  end_time_ = p.real("end");
+  fixed_dt_ = p.real("dt");
+  max_dt_ = p.real("dt_max");
+  resolved_["time"] = p.to_yaml();
+}
+
+void Simulation::read_physics(const ConfigNode& node) {
+  if (!node.is_map() || node.keys().empty())
+    throw node.error("list the physics to run, e.g. {thermal: {scheme: explicit}}; registered: " +
+                     join(registry_.names(Physics::kKind)));
+  YAML::Node resolved(YAML::NodeType::Map);
+  for (const auto& key : node.keys()) {
+    const ConfigNode section = node.child(key);
+    const RegistryEntry& entry = registry_.get(Physics::kKind, key, section.where());
+    const ParamSet params = parse_params(entry.schema, section);
+    physics_.push_back(registry_.create<Physics>(key, params, section.where()));
+    physics_keys_.push_back(key);
+    resolved[key] = params.to_yaml();
+  }
+  resolved_["physics"] = resolved;
+}
+
+void Simulation::read_materials(const ConfigNode& node) {
+  // One merged schema: a key several physics read (e.g. porosity) is validated once.
+  ParamSchema merged;
+  std::vector<ModelSlot> slots;
+  for (const auto& physics : physics_) {
+    const ParamSchema schema = physics->material_schema();
+    for (const auto& spec : schema.params())
+      if (!merged.find(spec.name)) {
+        auto& added = merged.real(spec.name, spec.unit, spec.doc);
+        added = spec;
+      }
+    for (const auto& slot : physics->material_models())
+      if (std::none_of(slots.begin(), slots.end(), [&](const ModelSlot& s) { return s.key == slot.key; }))
+        slots.push_back(slot);
+  }
+  std::vector<std::string> slot_keys;
+  for (const auto& slot : slots) slot_keys.push_back(slot.key);
+  if (!node.is_map() || node.keys().empty()) throw node.error("define at least one material: {name: {...}}");
+  YAML::Node resolved(YAML::NodeType::Map);
+  for (const auto& name : node.keys()) {
+    const ConfigNode section = node.child(name);
+    Material material;
+    material.name = name;
+    material.params = parse_params(merged, section, slot_keys);
+    YAML::Node out = material.params.to_yaml();
+    for (const auto& slot : slots) {
+      if (!section.has(slot.key)) {
+        if (slot.required)
+          throw section.error("missing required model section '" + slot.key + "' ({model: ...}); registered " +
+                              slot.kind + " models: " + join(registry_.names(slot.kind)));
+        continue;
+      }
+      auto model = read_model_section(registry_, slot.kind, section.child(slot.key));
+      out[slot.key] = model.resolved();
+      material.models.emplace(slot.key, std::move(model));
+    }
+    resolved[name] = out;
+    materials_.push_back(std::move(material));
+  }
+  resolved_["materials"] = resolved;
+}
+
+void Simulation::read_regions(const ConfigNode& node) {
+  struct Parsed {
+    RegionShape shape;
+    int material = 0;
+    std::unique_ptr<ConfigNode> initial;
+  };
+  std::vector<Parsed> regions;
+  YAML::Node resolved(YAML::NodeType::Sequence);
+  std::vector<std::string> material_names;
+  for (const auto& m : materials_) material_names.push_back(m.name);
+  for (const auto& item : node.elements()) {
+    Parsed r;
+    r.shape = read_region_shape(item.child("shape"));
+    const ConfigNode mat = item.child("material");
+    const std::string name = mat.as_string();
+    const auto it = std::find(material_names.begin(), material_names.end(), name);
+    if (it == material_names.end())
+      throw mat.error("unknown material '" + name + "'; defined: " + join(material_names));
+    r.material = static_cast<int>(it - material_names.begin());
+    if (auto init = item.optional_child("initial")) r.initial = std::make_unique<ConfigNode>(*init);
+    item.finish({"shape", "material", "initial"});
+    YAML::Node out;
+    out["shape"] = r.shape.resolved;
+    out["material"] = name;
+    if (r.initial) out["initial"] = YAML::Clone(r.initial->raw());
+    resolved.push_back(out);
+    regions.push_back(std::move(r));
+  }
+  if (regions.empty()) throw node.error("define at least one region");
+
+  // Each lattice point belongs to the last region containing it: write the background first,
+  // then inclusions on top.
+  const int ppc = static_cast<int>(resolved_["grid"]["particles_per_cell"].as<long>());
+  std::vector<std::vector<std::array<double, kDim>>> points(regions.size());
+  RegionShape everything{"all", [](const std::array<double, 2>&) { return true; }, {}};
+  for (const auto& x : sample_region(grid_, everything, ppc))
+    for (std::size_t r = regions.size(); r-- > 0;)
+      if (regions[r].shape.contains(x)) {
+        points[r].push_back(x);
+        break;
+      }
+  particles_.declare("position", kDim);
+  particles_.declare("volume", 1);
+  particles_.declare("half_size", kDim);
+  const double volume = grid_.cell_volume() / std::pow(ppc, kDim);
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    if (points[r].empty()) continue;
+    const ParticleRange range = particles_.append(points[r].size(), regions[r].material);
+    auto pos = particles_.field("position");
+    auto vol = particles_.field("volume");
+    auto half = particles_.field("half_size");
+    for (std::size_t i = 0; i < points[r].size(); ++i) {
+      const std::size_t p = range.begin + i;
+      for (int d = 0; d < kDim; ++d) {
+        pos[p * kDim + d] = points[r][i][d];
+        half[p * kDim + d] = 0.5 * grid_.spacing[d] / ppc;
+      }
+      vol[p] = volume;
+    }
+    region_inits_.push_back(RegionInit{range, {}, std::move(regions[r].initial)});
+  }
+  if (particles_.size() == 0) throw node.error("the regions contain no particles inside the grid");
+  resolved_["regions"] = resolved;
+}
+
+void Simulation::read_boundary_conditions(const ConfigNode& node) {
+  std::map<std::string, std::string> owner;
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    for (const auto& type : physics_[i]->boundary_types()) owner[type] = physics_keys_[i];
+  std::vector<std::string> types;
+  for (const auto& [t, _] : owner) types.push_back(t);
+  for (const auto& item : node.elements()) {
+    BoundaryCondition bc;
+    const ConfigNode type = item.child("type");
+    bc.type = type.as_string();
+    if (!owner.count(bc.type)) {
+      std::string message = "unknown boundary condition type '" + bc.type + "'";
+      const std::string hint = closest_match(bc.type, types);
+      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+      throw type.error(message + " Types of the physics in this scene: " + join(types));
+    }
+    const bool on_nodes = item.has("nodes");
+    const bool on_particles = item.has("particles");
+    if (on_nodes == on_particles) throw item.error("give exactly one target: 'nodes:' or 'particles:'");
+    if (on_nodes) {
+      const ConfigNode target = item.child("nodes");
+      if (auto face = target.optional_child("face")) {
+        bool ok = false;
+        const GridFace f = GridFace::parse(face->as_string(), kDim, ok);
+        if (!ok) throw face->error("'" + face->as_string() + "' is not a face; valid: x_min, x_max, y_min, y_max");
+        face_nodes(grid_, f, bc.nodes, bc.node_areas);
+        bc.target_text = "face " + f.name();
+      } else if (auto box = target.optional_child("box")) {
+        const auto lo = read_point(box->child("min"));
+        const auto hi = read_point(box->child("max"));
+        box->finish({"min", "max"});
+        bc.nodes = box_nodes<kDim>(grid_, lo, hi);
+        bc.node_areas.assign(bc.nodes.size(), 0.0);
+        bc.target_text = "node box";
+        if (bc.nodes.empty()) throw box->error("the box contains no grid nodes");
+      }
+      target.finish({"face", "box"});
+      if (bc.nodes.empty()) throw target.error("expected {face: NAME} or {box: {min, max}}");
+    } else {
+      const ConfigNode target = item.child("particles");
+      const RegionShape shape = read_region_shape(target);
+      const auto pos = particles_.field("position");
+      for (std::size_t p = 0; p < particles_.size(); ++p)
+        if (shape.contains({pos[p * kDim], pos[p * kDim + 1]})) bc.particles.push_back(p);
+      if (bc.particles.empty()) throw target.error("the shape contains no particles");
+      bc.on_particles = true;
+      bc.target_text = "particles in " + shape.kind;
+    }
+    // The owning physics reads the rest; `type` and the target are consumed here.
+    bc.node = std::make_unique<ConfigNode>(item);
+    bcs_.push_back(std::move(bc));
+  }
+  resolved_["boundary_conditions"] = YAML::Clone(node.raw());
+}
+
+std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::string& type) {
+  std::vector<BoundaryCondition*> out;
+  for (auto& bc : bcs_)
+    if (bc.type == type) out.push_back(&bc);
+  return out;
+}
+
+void Simulation::declare_state_field(const std::string& name, int components, double default_value) {
+  particles_.declare(name, components, default_value);
+  state_defaults_[name] = default_value;
+}
+
+void Simulation::apply_initial_values() {
+  std::vector<std::string> settable;
+  for (const auto& [name, _] : state_defaults_) settable.push_back(name);
+  for (auto& init : region_inits_) {
+    if (!init.node) continue;
+    const ConfigNode& node = *init.node;
+    node.reject_unknown(settable);
+    for (const auto& key : node.keys()) {
+      const double value = node.child(key).as_real();
+      auto column = particles_.field(key);
+      const int c = particles_.components(key);
+      for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+        for (int k = 0; k < c; ++k) column[p * c + k] = value;
+    }
+  }
+}
+
+std::vector<std::string> Simulation::physics_names() const { return physics_keys_; }
+
+void Simulation::read_output(const ConfigNode& node) {
+  ParamSchema s;
+  s.real("every", "s", "simulated time between field frames (fields.h5); 0 = first and last only")
+      .defaults_to(0.0).at_least(0);
+  s.real("metrics_every", "s", "simulated time between metrics.csv rows; 0 = every step").defaults_to(0.0).at_least(0);
+  s.boolean("progress", "print a progress line with time, step, dt and ETA").defaults_to(true);
+  const ParamSet p = parse_params(s, node, {"fields"});
+  output_every_ = p.real("every");
+  metrics_every_ = p.real("metrics_every");
+  YAML::Node out = p.to_yaml();
+  const auto names = particles_.field_names();
+  if (auto fields = node.optional_child("fields")) {
+    for (const auto& f : fields->elements()) {
+      const std::string name = f.as_string();
+      if (!particles_.has(name)) throw f.error("unknown field '" + name + "'; available: " + join(names));
+      if (name != "position") output_fields_.push_back(name);
+    }
+  }
+  out["fields"] = output_fields_;
+  resolved_["output"] = out;
+}
+
+void Simulation::read_probes(const ConfigNode* node) {
+  YAML::Node resolved(YAML::NodeType::Sequence);
+  if (node) {
+    static const std::vector<std::string> types = {"min", "max", "value_at", "integral", "isotherm"};
+    const auto names = particles_.field_names();
+    auto check_field = [&](const ConfigNode& f) {
+      const std::string name = f.as_string();
+      if (!particles_.has(name) || particles_.components(name) != 1)
+        throw f.error("unknown scalar field '" + name + "'; available: " + join(names));
+      return name;
+    };
+    for (const auto& item : node->elements()) {
+      auto probe = std::make_unique<Probe>();
+      const ConfigNode type = item.child("type");
+      probe->type = type.as_string();
+      if (std::find(types.begin(), types.end(), probe->type) == types.end())
+        throw type.error("unknown probe type '" + probe->type + "'; valid: " + join(types));
+      probe->name = item.child("name").as_string();
+      if (probe->type == "integral") {
+        for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
+        item.finish({"type", "name", "fields"});
+      } else {
+        probe->field = check_field(item.child("field"));
+        if (probe->type == "value_at") {
+          probe->point = read_point(item.child("point"));
+          item.finish({"type", "name", "field", "point"});
+        } else if (probe->type == "isotherm") {
+          probe->value = item.child("value").as_real();
+          probe->from = read_point(item.child("from"));
+          probe->to = read_point(item.child("to"));
+          item.finish({"type", "name", "field", "value", "from", "to"});
+        } else {
+          item.finish({"type", "name", "field"});
+        }
+      }
+      resolved.push_back(YAML::Clone(item.raw()));
+      probes_.push_back(std::move(probe));
+    }
+  }
+  resolved_["probes"] = resolved;
+}
+
+// ------------------------------------------------------------------------------------------
+
+void Simulation::advance(double dt) {
+  dt_ = dt;
+  auto timed = [&](const std::string& name, const std::function<void()>& fn) {
+    const auto start = Clock::now();
+    fn();
+    stats_.stage_seconds[name] += std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  if (positions_changed_) {
+    timed("kernel.stencil", [&] {
+      const long outside = stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+      if (outside >= 0) {
+        const auto pos = particles_.field("position");
+        std::ostringstream msg;
+        msg << "particle " << outside << " at (" << pos[outside * kDim] << ", " << pos[outside * kDim + 1]
+            << ") left the grid at t = " << time_ << " s (step " << step_ << ")";
+        throw NumericalBlowUp(msg.str());
+      }
+    });
+    positions_changed_ = false;  // particles move only when a mechanics stage says so
+  }
+  for (auto& physics : physics_) physics->begin_step(time_, dt);
+  for (auto& stage : stages_) timed(stage.name, stage.run);
+  time_ += dt;
+  ++step_;
+  stats_.steps++;
+  stats_.dt_sum += dt;
+  stats_.dt_min = stats_.steps == 1 ? dt : std::min(stats_.dt_min, dt);
+  stats_.dt_max = std::max(stats_.dt_max, dt);
+}
+
+void Simulation::check_finite() const {
+  const auto pos = particles_.field("position");
+  for (const auto& [name, _] : state_defaults_) {
+    const auto column = particles_.field(name);
+    const int c = particles_.components(name);
+    for (std::size_t i = 0; i < column.size(); ++i)
+      if (!std::isfinite(column[i])) {
+        const std::size_t p = i / c;
+        std::ostringstream msg;
+        msg << "numerical blow-up: " << name << " = " << column[i] << " at particle " << p << " (x = "
+            << pos[p * kDim] << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_
+            << " (dt = " << dt_ << " s)";
+        throw NumericalBlowUp(msg.str());
+      }
+  }
+}
+
+double Simulation::sample_field(const std::string& field, const std::array<double, kDim>& point) const {
+  // Volume-weighted nodal average of the particle field, then bilinear interpolation.
+  const auto values = particles_.field(field);
+  const auto vol = particles_.field("volume");
+  const std::size_t K = static_cast<std::size_t>(stencil_.per_particle());
+  std::array<int, kDim> base{};
+  std::array<double, kDim> frac{};
+  for (int d = 0; d < kDim; ++d) {
+    const double xi = std::clamp((point[d] - grid_.origin[d]) / grid_.spacing[d], 0.0, double(grid_.cells[d]));
+    base[d] = std::min(static_cast<int>(std::floor(xi)), grid_.cells[d] - 1);
+    frac[d] = xi - base[d];
+  }
+  std::array<std::size_t, 4> corner{};
+  std::array<double, 4> cw{}, num{}, den{};
+  for (int c = 0; c < 4; ++c) {
+    const int a = c & 1, b = c >> 1;
+    corner[c] = grid_.node_index({base[0] + a, base[1] + b});
+    cw[c] = (a ? frac[0] : 1 - frac[0]) * (b ? frac[1] : 1 - frac[1]);
+  }
+  // Only particles whose stencil touches the four corners contribute.
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const auto* nodes = stencil_.nodes(p);
+    const auto* w = stencil_.weights(p);
+    for (std::size_t k = 0; k < K; ++k)
+      for (int c = 0; c < 4; ++c)
+        if (nodes[k] == corner[c]) {
+          num[c] += vol[p] * w[k] * values[p];
+          den[c] += vol[p] * w[k];
+        }
+  }
+  double value = 0, weight = 0;
+  for (int c = 0; c < 4; ++c)
+    if (den[c] > 0) {
+      value += cw[c] * num[c] / den[c];
+      weight += cw[c];
+    }
+  return weight > 0 ? value / weight : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<double> Simulation::evaluate_probes() const {
+  std::vector<double> out;
+  const auto vol = particles_.field("volume");
+  for (const auto& probe : probes_) {
+    if (probe->type == "min" || probe->type == "max") {
+      const auto f = particles_.field(probe->field);
+      out.push_back(probe->type == "min" ? *std::min_element(f.begin(), f.end())
+                                         : *std::max_element(f.begin(), f.end()));
+    } else if (probe->type == "integral") {
+      double sum = 0;
+      std::vector<std::span<const double>> cols;
+      for (const auto& name : probe->fields) cols.push_back(particles_.field(name));
+      for (std::size_t p = 0; p < particles_.size(); ++p) {
+        double v = vol[p];
+        for (const auto& c : cols) v *= c[p];
+        sum += v;
+      }
+      out.push_back(sum);
+    } else if (probe->type == "value_at") {
+      out.push_back(sample_field(probe->field, probe->point));
+    } else {  // isotherm: distance from `from` to the first crossing of `value` along the line
+      const double length = std::hypot(probe->to[0] - probe->from[0], probe->to[1] - probe->from[1]);
+      const int samples = std::max(2, static_cast<int>(std::ceil(4 * length / grid_.min_spacing())));
+      double previous = 0, crossing = std::numeric_limits<double>::quiet_NaN();
+      for (int s = 0; s <= samples; ++s) {
+        const double f = double(s) / samples;
+        const double v = sample_field(probe->field, {probe->from[0] + f * (probe->to[0] - probe->from[0]),
+                                                     probe->from[1] + f * (probe->to[1] - probe->from[1])}) -
+                         probe->value;
+        if (s > 0 && (previous > 0) != (v > 0)) {
+          const double f0 = double(s - 1) / samples;
+          crossing = (f0 + (f - f0) * previous / (previous - v)) * length;
+          break;
+        }
+        previous = v;
+      }
+      out.push_back(crossing);
+    }
+  }
+  return out;
+}
+
+void Simulation::run(const OutputDir& out, bool progress) {
+  ParticleFieldWriter writer(out.path(), kDim);
+  std::ofstream metrics(out.file("metrics.csv"));
+  metrics << "time_s,step,dt_s";
+  for (const auto& probe : probes_) metrics << ',' << probe->name;
+  metrics << '\n' << std::setprecision(12);
+
+  auto write_frame = [&] {
+    std::vector<FieldView> views;
+    for (const auto& name : output_fields_)
+      views.push_back({name, particles_.field(name).data(), particles_.components(name)});
+    writer.write(time_, step_, particles_.size(), particles_.field("position").data(), views);
+  };
+  auto write_metrics = [&] {
+    metrics << time_ << ',' << step_ << ',' << dt_;
+    for (double v : evaluate_probes()) metrics << ',' << v;
+    metrics << '\n';
+    metrics.flush();
+  };
+
+  // The stencil is needed by the first probe evaluation.
+  stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  for (auto& physics : physics_) physics->initialize();
+  write_frame();
+  write_metrics();
+  const double eps = 1e-9 * end_time_;
+  double next_output = output_every_ > 0 ? output_every_ : end_time_;
+  double next_metrics = metrics_every_ > 0 ? metrics_every_ : 0;
+  const auto wall_start = Clock::now();
+  auto last_print = wall_start;
+  while (time_ < end_time_ - eps) {
+    double dt = fixed_dt_ > 0 ? fixed_dt_ : std::numeric_limits<double>::infinity();
+    for (const auto& physics : physics_) dt = std::min(dt, physics->stable_time_step());
+    if (max_dt_ > 0) dt = std::min(dt, max_dt_);
+    if (!std::isfinite(dt)) dt = end_time_ - time_;
+    // Land exactly on output, metrics and end times (never leave a sliver step behind).
+    for (double target : {next_output, metrics_every_ > 0 ? next_metrics : end_time_, end_time_})
+      if (target > time_ + eps && time_ + dt > target - eps) dt = target - time_;
+    advance(dt);
+    check_finite();
+    if (metrics_every_ <= 0 || time_ >= next_metrics - eps) {
+      write_metrics();
+      if (metrics_every_ > 0) next_metrics += metrics_every_;
+    }
+    if (time_ >= next_output - eps) {
+      write_frame();
+      next_output = output_every_ > 0 ? std::min(next_output + output_every_, end_time_) : end_time_;
+      if (next_output <= time_ + eps) next_output = end_time_ + 1;
+    }
+    if (progress && std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
+      last_print = Clock::now();
+      const double wall = std::chrono::duration<double>(last_print - wall_start).count();
+      const double eta = wall * (end_time_ - time_) / std::max(time_, 1e-300);
+      std::cerr << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
+                << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s\n"
+                << std::defaultfloat;
+    }
+  }
+}
+
+}  // namespace frostmpm

@@ -1,0 +1,135 @@
+#pragma once
+// The kernel's state and step loop: grid, particles (structure of arrays), stencil cache,
+// materials, boundary conditions, the physics in play and their stages, output and probes.
+// 2-D today; grid, shape functions and stencils are templated on the dimension.
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "frostmpm/config/config_node.hpp"
+#include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/particles/particle_store.hpp"
+#include "frostmpm/physics/physics.hpp"
+#include "frostmpm/plugin/registry.hpp"
+#include "frostmpm/scene/model_section.hpp"
+#include "frostmpm/shape/stencil_cache.hpp"
+
+namespace frostmpm {
+
+class OutputDir;
+class ParticleFieldWriter;
+
+inline constexpr int kDim = 2;
+
+struct Material {
+  std::string name;
+  ParamSet params;                               ///< merged schema of every active physics
+  std::map<std::string, ModelSection> models;    ///< by slot key, e.g. "sfcc"
+};
+
+/// A boundary condition as the kernel parsed it: where it acts; the physics owning `type`
+/// reads its own keys from `node` (and must call node.finish()).
+struct BoundaryCondition {
+  std::string type;
+  std::string target_text;              ///< e.g. "face y_max", for messages
+  std::vector<std::size_t> nodes;       ///< node targets
+  std::vector<double> node_areas;       ///< face area per node (0 for box node sets)
+  std::vector<std::size_t> particles;   ///< particle targets
+  bool on_particles = false;
+  std::unique_ptr<ConfigNode> node;
+};
+
+/// Thrown when the solution stops being finite; the message says where and when.
+class NumericalBlowUp : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+inline constexpr int kBlowUpExitCode = 3;
+
+struct StepStatistics {
+  long steps = 0;
+  double dt_min = 0, dt_max = 0, dt_sum = 0;
+  std::map<std::string, double> stage_seconds;
+};
+
+class Simulation {
+ public:
+  /// Reads and validates every section of a simulation scene (grid, time, materials,
+  /// physics, regions, boundary_conditions, output, probes). Throws InputError.
+  Simulation(const Registry& registry, const ConfigNode& root);
+  ~Simulation();
+
+  static std::vector<std::string> sections();
+  YAML::Node resolved() const { return resolved_; }
+
+  /// Runs to the end time, writing fields.h5/.xdmf, metrics.csv into `out`.
+  void run(const OutputDir& out, bool progress);
+
+  // ---- what physics plugins use ----
+  const UniformGrid<kDim>& grid() const { return grid_; }
+  ParticleStore& particles() { return particles_; }
+  const ParticleStore& particles() const { return particles_; }
+  const StencilCache<kDim>& stencil() const { return stencil_; }
+  const std::vector<Material>& materials() const { return materials_; }
+  const Registry& registry() const { return registry_; }
+  /// Boundary conditions whose type a physics owns.
+  std::vector<BoundaryCondition*> boundary_conditions(const std::string& type);
+  /// Declares a particle field that regions may initialise with `initial: {name: value}`.
+  void declare_state_field(const std::string& name, int components, double default_value);
+  /// Fields a physics can offer to output and probes (declared state or derived fields).
+  double time() const { return time_; }
+  double dt() const { return dt_; }
+  long step() const { return step_; }
+  double end_time() const { return end_time_; }
+  /// User-fixed time step (0 when automatic).
+  double fixed_dt() const { return fixed_dt_; }
+
+  const StepStatistics& statistics() const { return stats_; }
+  const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
+  std::vector<std::string> physics_names() const;
+
+  /// Advances one step of size dt (exposed for tests and benchmarks).
+  void advance(double dt);
+  /// Value of a particle field interpolated to a point through the grid (volume-weighted).
+  double sample_field(const std::string& field, const std::array<double, kDim>& point) const;
+
+ private:
+  struct Probe;
+  struct RegionInit;
+  const Registry& registry_;
+  UniformGrid<kDim> grid_;
+  ShapeKind shape_ = ShapeKind::Gimp;
+  StencilCache<kDim> stencil_;
+  ParticleStore particles_;
+  std::vector<Material> materials_;
+  std::vector<BoundaryCondition> bcs_;
+  std::vector<std::shared_ptr<Physics>> physics_;
+  std::vector<std::string> physics_keys_;
+  std::vector<Stage> stages_;
+  std::vector<RegionInit> region_inits_;
+  std::vector<std::unique_ptr<Probe>> probes_;
+  std::vector<std::string> output_fields_;
+  std::map<std::string, double> state_defaults_;
+  double time_ = 0, dt_ = 0, end_time_ = 0, fixed_dt_ = 0, max_dt_ = 0;
+  double output_every_ = 0, metrics_every_ = 0;
+  long step_ = 0;
+  bool positions_changed_ = true;
+  StepStatistics stats_;
+  YAML::Node resolved_;
+
+  void read_grid(const ConfigNode& node);
+  void read_time(const ConfigNode& node);
+  void read_physics(const ConfigNode& node);
+  void read_materials(const ConfigNode& node);
+  void read_regions(const ConfigNode& node);
+  void read_boundary_conditions(const ConfigNode& node);
+  void read_output(const ConfigNode& node);
+  void read_probes(const ConfigNode* node);
+  void apply_initial_values();
+  void check_finite() const;
+  std::vector<double> evaluate_probes() const;
+};
+
+}  // namespace frostmpm
