@@ -168,7 +168,13 @@ int main(int argc, char** argv) {
   describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)");
 
   try {
-    CLI11_PARSE(cli, argc, argv);
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; a malformed command line is bad input like any other.
+    const int code = cli.exit(e);
+    return code == 0 ? 0 : kInputErrorExitCode;
+  }
+  try {
     if (*run) return cmd_run(run_options, out_dir);
     if (*check) return cmd_check(check_options);
     if (*plugins) return app::cmd_plugins(list_paths, std::cout);

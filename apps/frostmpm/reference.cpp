@@ -16,10 +16,16 @@ struct LoadedRegistry {
   }
 };
 
+// Models are chosen with `model:` inside a section; physics are keys of `physics:`.
+std::string scene_form(const RegistryEntry& e) {
+  if (e.kind == "physics") return "physics: {" + e.name + ": {...}}";
+  return "{model: " + e.name + (e.schema.params().empty() ? "}" : ", ...}");
+}
+
 void describe_text(const RegistryEntry& e, std::ostream& out) {
   out << e.kind << "/" << e.name << " — " << e.doc << "\n";
   out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
-  out << "  YAML: {model: " << e.name << (e.schema.params().empty() ? "" : ", ...") << "}\n";
+  out << "  YAML: " << scene_form(e) << "\n";
   for (const auto& p : e.schema.params()) {
     out << "  " << std::left << std::setw(22) << p.name << std::setw(14) << to_string(p.type)
         << std::setw(10) << (p.unit.empty() ? "-" : p.unit) << std::setw(16) << p.default_text();
@@ -30,7 +36,7 @@ void describe_text(const RegistryEntry& e, std::ostream& out) {
 
 void describe_markdown(const RegistryEntry& e, std::ostream& out) {
   out << "### `" << e.kind << "/" << e.name << "`\n\n" << e.doc << ".\n\n";
-  out << "Plugin `" << e.plugin << "`. Scene form: `{model: " << e.name << ", ...}`.\n\n";
+  out << "Plugin `" << e.plugin << "`. Scene form: `" << scene_form(e) << "`.\n\n";
   out << "| parameter | type | unit | default | allowed | description |\n|---|---|---|---|---|---|\n";
   for (const auto& p : e.schema.params()) {
     const std::string range = p.type == ParamType::Choice ? join(p.choices) : p.range_text();

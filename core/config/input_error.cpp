@@ -4,6 +4,8 @@
 
 namespace frostmpm {
 
+InputError::~InputError() = default;
+
 std::string SourceLocation::describe() const {
   std::string out = file.empty() ? std::string("<input>") : file;
   if (line > 0) {

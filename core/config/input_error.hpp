@@ -23,6 +23,9 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
   InputError(const SourceLocation& where, const std::string& message)
       : std::runtime_error(where.describe() + ": " + message) {}
+  // Out of line: the vtable then lives in the core library, so an InputError thrown by plugin
+  // code stays valid after that plugin's library is released during unwinding.
+  ~InputError() override;
 };
 
 /// Exit code for every InputError (bad scene, bad option, bad plugin file).

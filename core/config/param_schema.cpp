@@ -43,6 +43,29 @@ YAML::Node to_yaml(const ParamValue& value) {
   return node;
 }
 
+ParamSpec& ParamSpec::defaults_to(double value) {
+  if (type == ParamType::Integer) default_value = static_cast<long>(value);
+  else if (type == ParamType::Real) default_value = value;
+  else throw std::logic_error("parameter '" + name + "' is not numeric; its default cannot be a number");
+  return *this;
+}
+ParamSpec& ParamSpec::defaults_to(bool value) {
+  if (type != ParamType::Boolean) throw std::logic_error("parameter '" + name + "' is not a boolean");
+  default_value = value;
+  return *this;
+}
+ParamSpec& ParamSpec::defaults_to(std::string text) {
+  if (type != ParamType::String && type != ParamType::Choice)
+    throw std::logic_error("parameter '" + name + "' does not take text");
+  default_value = std::move(text);
+  return *this;
+}
+ParamSpec& ParamSpec::defaults_to(std::vector<double> values) {
+  if (type != ParamType::RealList) throw std::logic_error("parameter '" + name + "' is not a list");
+  default_value = std::move(values);
+  return *this;
+}
+
 std::string ParamSpec::range_text() const {
   if (!lower && !upper) return "";
   std::string out = lower ? (lower_open ? "(" : "[") + number_text(*lower) : "(-inf";

@@ -33,9 +33,15 @@ struct ParamSpec {
   bool required() const { return !default_value.has_value(); }
 
   // Fluent setters used by schema declarations.
-  ParamSpec& defaults_to(ParamValue value) { default_value = std::move(value); return *this; }
-  // Without this, a string literal would silently pick the bool alternative of ParamValue.
-  ParamSpec& defaults_to(const char* text) { default_value = std::string(text); return *this; }
+  // Defaults are stored in the parameter's own type: `defaults_to(0)` on a real is 0.0, and a
+  // string literal can never turn into the bool alternative.
+  ParamSpec& defaults_to(double value);
+  ParamSpec& defaults_to(int value) { return defaults_to(static_cast<double>(value)); }
+  ParamSpec& defaults_to(long value) { return defaults_to(static_cast<double>(value)); }
+  ParamSpec& defaults_to(bool value);
+  ParamSpec& defaults_to(const char* text) { return defaults_to(std::string(text)); }
+  ParamSpec& defaults_to(std::string text);
+  ParamSpec& defaults_to(std::vector<double> values);
   ParamSpec& at_least(double v) { lower = v; lower_open = false; return *this; }
   ParamSpec& above(double v) { lower = v; lower_open = true; return *this; }
   ParamSpec& at_most(double v) { upper = v; upper_open = false; return *this; }

@@ -534,7 +534,7 @@ void Simulation::run(const OutputDir& out, bool progress) {
   write_frame();
   write_metrics();
   const double eps = 1e-9 * end_time_;
-  double next_output = output_every_ > 0 ? output_every_ : end_time_;
+  double next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;
   double next_metrics = metrics_every_ > 0 ? metrics_every_ : 0;
   const auto wall_start = Clock::now();
   auto last_print = wall_start;
@@ -543,14 +543,19 @@ void Simulation::run(const OutputDir& out, bool progress) {
     for (const auto& physics : physics_) dt = std::min(dt, physics->stable_time_step());
     if (max_dt_ > 0) dt = std::min(dt, max_dt_);
     if (!std::isfinite(dt)) dt = end_time_ - time_;
-    // Land exactly on output, metrics and end times (never leave a sliver step behind).
-    for (double target : {next_output, metrics_every_ > 0 ? next_metrics : end_time_, end_time_})
-      if (target > time_ + eps && time_ + dt > target - eps) dt = target - time_;
+    // Land exactly on output, metrics and end times without leaving a sliver step: when the
+    // target is less than two steps away, split the remaining gap in two.
+    for (double target : {next_output, metrics_every_ > 0 ? std::min(next_metrics, end_time_) : end_time_, end_time_}) {
+      const double gap = target - time_;
+      if (gap <= eps) continue;
+      if (dt >= gap - eps) dt = gap;
+      else if (2 * dt > gap) dt = 0.5 * gap;
+    }
     advance(dt);
     check_finite();
-    if (metrics_every_ <= 0 || time_ >= next_metrics - eps) {
+    if (metrics_every_ <= 0 || time_ >= next_metrics - eps || time_ >= end_time_ - eps) {
       write_metrics();
-      if (metrics_every_ > 0) next_metrics += metrics_every_;
+      while (metrics_every_ > 0 && next_metrics <= time_ + eps) next_metrics += metrics_every_;
     }
     if (time_ >= next_output - eps) {
       write_frame();

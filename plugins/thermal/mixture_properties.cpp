@@ -37,55 +37,58 @@ PhaseConstants phase_constants(const ParamSet& m, ConductivityAverage average, b
 int invert_heat(const SfccModel& sfcc, const PhaseConstants& pc, std::span<const double> porosity,
                 std::span<const double> energy, std::span<double> T, std::span<double> S) {
   const std::size_t n = T.size();
-  std::vector<double> T0(T.begin(), T.end()), S0(n), trial(n), St(n), dS(n), dSdp(n), lo(n), hi(n), x(n);
-  std::vector<char> done(n, 0);
-  sfcc.evaluate(T0, {}, SfccResult{S0, dS, dSdp});
-  // Initial guess from the sensible+apparent capacity at the start; bracket from the
-  // sensible heat alone (latent heat only adds capacity, so |ΔT| ≤ |E|/C_min).
+  std::vector<double> T0(T.begin(), T.end()), S0(n), dS0(n), unused(n), lo(n), hi(n), x(n);
+  sfcc.evaluate(T0, {}, SfccResult{S0, dS0, unused});
+  // Start from the apparent capacity at T0, bracketed by the sensible heat alone (latent heat
+  // only adds capacity, so |ΔT| ≤ |E|/C_min).
+  std::vector<std::size_t> active;
   for (std::size_t i = 0; i < n; ++i) {
-    const double c_min = std::min(pc.capacity(porosity[i], 0.0), pc.capacity(porosity[i], 1.0));
+    const double phi = porosity[i];
+    const double c_min = std::min(pc.capacity(phi, 0.0), pc.capacity(phi, 1.0));
     const double bound = std::abs(energy[i]) / c_min * 1.000001 + 1e-12;
     lo[i] = energy[i] >= 0 ? 0.0 : -bound;
     hi[i] = energy[i] >= 0 ? bound : 0.0;
-    const double apparent = pc.capacity(porosity[i], S0[i]) + pc.latent_density * porosity[i] * dS[i];
+    const double apparent = pc.capacity(phi, S0[i]) + pc.latent_density * phi * dS0[i];
     x[i] = std::clamp(energy[i] / apparent, lo[i], hi[i]);
-    if (energy[i] == 0.0) done[i] = 1, x[i] = 0.0;
+    S[i] = S0[i];
+    // Below 1e-10 °C of sensible heat there is nothing to resolve.
+    if (std::abs(energy[i]) > 1e-10 * c_min) active.push_back(i);
+    else T[i] = T0[i] + x[i];
   }
+  // Newton on the still-unconverged particles only, one SFCC batch call per iteration.
+  std::vector<double> trial, St, dS, dSdp;
   int iterations = 0;
-  for (; iterations < 100; ++iterations) {
-    for (std::size_t i = 0; i < n; ++i) trial[i] = T0[i] + x[i];
+  while (!active.empty() && iterations < 100) {
+    ++iterations;
+    const std::size_t m = active.size();
+    trial.resize(m);
+    St.resize(m);
+    dS.resize(m);
+    dSdp.resize(m);
+    for (std::size_t a = 0; a < m; ++a) trial[a] = T0[active[a]] + x[active[a]];
     sfcc.evaluate(trial, {}, SfccResult{St, dS, dSdp});
-    bool all_done = true;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (done[i]) continue;
+    std::size_t kept = 0;
+    for (std::size_t a = 0; a < m; ++a) {
+      const std::size_t i = active[a];
       const double phi = porosity[i];
-      const double residual = pc.heat(phi, T0[i], S0[i], trial[i], St[i]) - energy[i];
-      // Converged when the remaining energy error is worth less than 1e-10 °C of sensible heat.
+      const double residual = pc.heat(phi, T0[i], S0[i], trial[a], St[a]) - energy[i];
       const double capacity = std::min(pc.capacity(phi, 0.0), pc.capacity(phi, 1.0));
-      if (std::abs(residual) <= 1e-10 * capacity || hi[i] - lo[i] <= 1e-12 * (1 + std::abs(T0[i]))) {
-        done[i] = 1;
-        continue;
-      }
-      all_done = false;
+      T[i] = trial[a];
+      S[i] = St[a];
+      // Converged when the energy error is worth less than 1e-10 °C of sensible heat.
+      if (std::abs(residual) <= 1e-10 * capacity || hi[i] - lo[i] <= 1e-12 * (1 + std::abs(T0[i]))) continue;
       if (residual > 0) hi[i] = x[i];
       else lo[i] = x[i];
-      // d heat/dΔT at the trial point (trapezoid term + latent term)
-      const double cap1 = pc.capacity(phi, St[i]);
-      const double dcap = phi * (pc.water_capacity - pc.ice_capacity) * dS[i];
-      const double slope = 0.5 * (pc.capacity(phi, S0[i]) + cap1) + 0.5 * dcap * x[i] +
-                           pc.latent_density * phi * dS[i];
+      const double dcap = phi * (pc.water_capacity - pc.ice_capacity) * dS[a];
+      const double slope = 0.5 * (pc.capacity(phi, S0[i]) + pc.capacity(phi, St[a])) + 0.5 * dcap * x[i] +
+                           pc.latent_density * phi * dS[a];
       double next = slope > 0 ? x[i] - residual / slope : 0.5 * (lo[i] + hi[i]);
       if (!(next > lo[i] && next < hi[i])) next = 0.5 * (lo[i] + hi[i]);  // Newton left the bracket
       x[i] = next;
+      active[kept++] = i;
     }
-    if (all_done) break;
+    active.resize(kept);
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    T[i] = T0[i] + x[i];
-    S[i] = St[i];
-  }
-  // S must match the final T exactly (x may have moved after the last evaluation).
-  sfcc.evaluate(T, {}, SfccResult{S, dS, dSdp});
   return iterations;
 }
 

@@ -82,7 +82,7 @@ class ThermalPhysics final : public Physics {
       throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
 
     const std::size_t nodes = sim.grid().node_count();
-    for (auto* v : {&node_volume_, &node_T_, &node_energy_, &node_force_, &node_capacity_, &node_dT_, &dirichlet_target_,
+    for (auto* v : {&node_volume_, &node_T_, &node_force_, &node_capacity_, &node_dT_, &dirichlet_target_,
                     &dirichlet_start_})
       v->assign(nodes, 0.0);
     dirichlet_.assign(nodes, 0);
@@ -100,7 +100,10 @@ class ThermalPhysics final : public Physics {
     if (!initialized_) const_cast<ThermalPhysics*>(this)->initialize();
     if (!properties_valid_) const_cast<ThermalPhysics*>(this)->update_properties();
     const double h = sim_->grid().min_spacing();
-    return cfl_ * h * h / (2.0 * kDim * max_diffusivity_);
+    double dt = cfl_ * h * h / (2.0 * kDim * max_diffusivity_);
+    // A convective face is a spring h·A on the node: keep Δt below C V_i/(h A_i) ≈ C (Δx/2)/h.
+    for (const auto& bc : convective_) dt = std::min(dt, cfl_ * min_capacity_ * 0.5 * h / bc.coefficient);
+    return dt;
   }
 
   void initialize() override {
@@ -115,6 +118,7 @@ class ThermalPhysics final : public Physics {
 
   void begin_step(double time, double dt) override {
     if (!initialized_) initialize();
+    start_saturation_valid_ = false;
     time_ = time;
     dt_ = dt;
   }
@@ -141,22 +145,24 @@ class ThermalPhysics final : public Physics {
 
   ParamSet params_;
   Simulation* sim_ = nullptr;
-  bool implicit_ = false, pic_properties_ = true, initialized_ = false, properties_valid_ = false;
-  double flip_fraction_ = 1, cfl_ = 0.5, time_ = 0, dt_ = 0, max_diffusivity_ = 0;
+  bool implicit_ = false, pic_properties_ = true, initialized_ = false, properties_valid_ = false,
+       start_saturation_valid_ = false;
+  double flip_fraction_ = 1, cfl_ = 0.5, time_ = 0, dt_ = 0, max_diffusivity_ = 0, min_capacity_ = 0;
   std::vector<PhaseConstants> constants_;
   std::vector<std::shared_ptr<SfccModel>> sfcc_;
   std::vector<NodeCondition> fixed_T_, flux_, convective_;
   std::vector<ParticleCondition> particle_T_;
 
   // Per-particle scratch (plugin-owned, not particle fields): capacity, conductivity, dS/dT.
-  std::vector<double> capacity_, conductivity_, slope_, energy_, scratch_a_, scratch_b_;
+  std::vector<double> capacity_, conductivity_, slope_, energy_, scratch_a_;
   // Nodal arrays.
-  std::vector<double> node_volume_, node_T_, node_energy_, node_force_, node_capacity_, node_dT_,
+  std::vector<double> node_volume_, node_T_, node_force_, node_capacity_, node_dT_,
       dirichlet_target_, dirichlet_start_;
   std::vector<char> dirichlet_;
+  std::vector<double> particle_chord_, nodal_capacity_, c_T1_, c_S0_, c_S1_, c_dS0_, c_dS1_, c_unused_, c_delta_;
   // Implicit: matrix graph built from the stencil, reused while the stencil topology holds.
   std::unique_ptr<SparseSystem> system_;
-  std::vector<double> stiffness_, matrix_values_, rhs_;
+  std::vector<double> stiffness_, matrix_values_, rhs_, constraint_dT_;
   std::vector<std::size_t> offsets_;  ///< CSR pattern (kept for constraint elimination)
   std::vector<int> columns_;
   std::vector<int> scatter_;         ///< CSR position of every (particle, k1, k2) pair
@@ -201,6 +207,7 @@ class ThermalPhysics final : public Physics {
     const auto phi = particles.field("porosity");
     auto S = particles.field("liquid_saturation");
     max_diffusivity_ = 0;
+    min_capacity_ = std::numeric_limits<double>::infinity();
     for (const auto& r : particles.ranges()) {
       const auto& pc = constants_[r.material];
       sfcc_[r.material]->evaluate(T.subspan(r.begin, r.size()), {},
@@ -210,6 +217,7 @@ class ThermalPhysics final : public Physics {
         capacity_[p] = pc.capacity(phi[p], S[p]);
         conductivity_[p] = pc.conductivity(phi[p], S[p]);
         max_diffusivity_ = std::max(max_diffusivity_, conductivity_[p] / capacity_[p]);
+        min_capacity_ = std::min(min_capacity_, capacity_[p]);
       }
     }
     properties_valid_ = true;
@@ -282,77 +290,66 @@ class ThermalPhysics final : public Physics {
     }
   }
 
-  /// Chord capacity of every particle for a temperature change ΔT_p = Σ_i S_ip node_dT_i:
-  /// heat(T → T + ΔT)/ΔT, or the apparent capacity C + ρL φ dS/dT when ΔT is tiny.
-  void chord_capacity(std::vector<double>& chord) {
+  /// Chord capacity of every particle for the temperature change ΔT_p = Σ_i S_ip node_dT_i:
+  /// c_p = heat(T_p → T_p + ΔT_p)/ΔT_p, or the apparent capacity C + ρL φ dS/dT when ΔT_p is
+  /// tiny (stored in particle_chord_), and the nodal chord capacity C̃_i = Σ_p V_p S_ip c_p / V_i.
+  void nodal_chord_capacity(std::vector<double>& nodal) {
     const auto& st = sim_->stencil();
     auto& particles = sim_->particles();
     const auto T = particles.field("temperature");
     const auto phi = particles.field("porosity");
-    const std::size_t n = particles.size();
+    const auto vol = particles.field("volume");
     const int K = st.per_particle();
-    chord.resize(n);
-    std::vector<double>& shifted = scratch_a_;
-    std::vector<double>& delta = scratch_b_;
-    shifted.resize(n);
-    delta.resize(n);
+    const std::size_t n = particles.size();
+    std::fill(nodal.begin(), nodal.end(), 0.0);
+    for (auto* v : {&particle_chord_, &c_T1_, &c_S0_, &c_S1_, &c_dS0_, &c_dS1_, &c_unused_, &c_delta_}) v->resize(n);
     for (std::size_t p = 0; p < n; ++p) {
       const auto* nodes = st.nodes(p);
       const auto* w = st.weights(p);
       double d = 0;
       for (int k = 0; k < K; ++k) d += w[k] * node_dT_[nodes[k]];
-      delta[p] = d;
-      shifted[p] = T[p] + d;
+      c_delta_[p] = d;
+      c_T1_[p] = T[p] + d;
     }
-    std::vector<double> S0(n), S1(n), dS0(n), dS1(n), unused(n);
+    bool any_change = false;
+    for (std::size_t p = 0; p < n && !any_change; ++p) any_change = std::abs(c_delta_[p]) > 1e-9;
     for (const auto& r : particles.ranges()) {
       auto sub = [&](std::vector<double>& v) { return std::span(v).subspan(r.begin, r.size()); };
-      sfcc_[r.material]->evaluate(T.subspan(r.begin, r.size()), {}, SfccResult{sub(S0), sub(dS0), sub(unused)});
-      sfcc_[r.material]->evaluate(sub(shifted), {}, SfccResult{sub(S1), sub(dS1), sub(unused)});
+      // S_l(T_p) is the same for every call within a step: evaluate it once.
+      if (!start_saturation_valid_)
+        sfcc_[r.material]->evaluate(T.subspan(r.begin, r.size()), {}, SfccResult{sub(c_S0_), sub(c_dS0_), sub(c_unused_)});
+      if (any_change)
+        sfcc_[r.material]->evaluate(sub(c_T1_), {}, SfccResult{sub(c_S1_), sub(c_dS1_), sub(c_unused_)});
       const auto& pc = constants_[r.material];
       for (std::size_t p = r.begin; p < r.end; ++p) {
-        if (std::abs(delta[p]) > 1e-9) {
-          chord[p] = pc.heat(phi[p], T[p], S0[p], shifted[p], S1[p]) / delta[p];
-        } else {
-          chord[p] = pc.capacity(phi[p], S0[p]) + pc.latent_density * phi[p] * dS0[p];
-        }
+        const double chord = std::abs(c_delta_[p]) > 1e-9
+                                 ? pc.heat(phi[p], T[p], c_S0_[p], c_T1_[p], c_S1_[p]) / c_delta_[p]
+                                 : pc.capacity(phi[p], c_S0_[p]) + pc.latent_density * phi[p] * c_dS0_[p];
+        particle_chord_[p] = chord;
+        const auto* nodes = st.nodes(p);
+        const auto* w = st.weights(p);
+        for (int k = 0; k < K; ++k) nodal[nodes[k]] += vol[p] * w[k] * chord;
       }
     }
-  }
-
-  /// Nodal chord capacity C̃_i = Σ_p V_p S_ip c_p / V_i for the current node_dT_.
-  void nodal_chord_capacity(std::vector<double>& chord, std::vector<double>& nodal) {
-    chord_capacity(chord);
-    const auto& st = sim_->stencil();
-    const auto vol = sim_->particles().field("volume");
-    std::fill(nodal.begin(), nodal.end(), 0.0);
-    const int K = st.per_particle();
-    for (std::size_t p = 0; p < sim_->particles().size(); ++p) {
-      const auto* nodes = st.nodes(p);
-      const auto* w = st.weights(p);
-      for (int k = 0; k < K; ++k) nodal[nodes[k]] += vol[p] * w[k] * chord[p];
-    }
+    start_saturation_valid_ = true;
     for (std::size_t i = 0; i < nodal.size(); ++i) nodal[i] = node_volume_[i] > 0 ? nodal[i] / node_volume_[i] : 0.0;
   }
 
   void solve_explicit() {
     conduction_force();
-    // Free nodes: energy from the conductive and boundary fluxes. Dirichlet nodes: the energy
-    // that brings the surrounding particles to the prescribed temperature (chord capacity).
+    // Free nodes gain Δt f_i of energy per V_i; their temperature change is that energy over
+    // the nodal chord capacity, found by two fixed-point passes (tangent, then chord).
+    // Dirichlet nodes move their particles from where they are to the prescribed value.
+    const std::size_t nodes = node_volume_.size();
     std::fill(node_dT_.begin(), node_dT_.end(), 0.0);
-    bool any_dirichlet = false;
-    for (std::size_t i = 0; i < node_energy_.size(); ++i) {
-      if (dirichlet_[i]) {
-        node_dT_[i] = dirichlet_target_[i] - dirichlet_start_[i];
-        any_dirichlet = true;
-      }
-    }
-    std::vector<double> chord, nodal_capacity(node_energy_.size());
-    if (any_dirichlet) nodal_chord_capacity(chord, nodal_capacity);
-    for (std::size_t i = 0; i < node_energy_.size(); ++i) {
-      if (node_volume_[i] <= 0) node_energy_[i] = 0;
-      else if (dirichlet_[i]) node_energy_[i] = nodal_capacity[i] * node_dT_[i];
-      else node_energy_[i] = dt_ * node_force_[i] / node_volume_[i];
+    for (std::size_t i = 0; i < nodes; ++i)
+      if (dirichlet_[i]) node_dT_[i] = dirichlet_target_[i] - dirichlet_start_[i];
+    nodal_capacity_.resize(nodes);
+    for (int pass = 0; pass < 2; ++pass) {
+      nodal_chord_capacity(nodal_capacity_);
+      for (std::size_t i = 0; i < nodes; ++i)
+        if (!dirichlet_[i])
+          node_dT_[i] = node_volume_[i] > 0 ? dt_ * node_force_[i] / (node_volume_[i] * nodal_capacity_[i]) : 0.0;
     }
   }
 
@@ -426,11 +423,18 @@ class ThermalPhysics final : public Physics {
       for (std::size_t j = 0; j < bc.nodes.size(); ++j)
         stiffness_[diagonal_[bc.nodes[j]]] += bc.coefficient * bc.areas[j];
 
+    // A Dirichlet node has two increments: its particles must go from where they are to the
+    // target (energy, node_dT_), while the conduction operator already saw the prescribed value
+    // now, so the system eliminates it with target − now (constraint_dT_).
     const std::size_t nodes = node_volume_.size();
     std::fill(node_dT_.begin(), node_dT_.end(), 0.0);
+    constraint_dT_.assign(nodes, 0.0);
     for (std::size_t i = 0; i < nodes; ++i)
-      if (dirichlet_[i]) node_dT_[i] = dirichlet_target_[i] - dirichlet_start_[i];
-    std::vector<double> chord, nodal_capacity(nodes), previous(nodes), solution(node_dT_);
+      if (dirichlet_[i]) {
+        node_dT_[i] = dirichlet_target_[i] - dirichlet_start_[i];
+        constraint_dT_[i] = dirichlet_target_[i] - node_T_[i];
+      }
+    std::vector<double> nodal_capacity(nodes), solution(nodes);
     rhs_.assign(nodes, 0.0);
     const double tolerance = params_.real("nonlinear_tolerance");
     const long max_iterations = params_.integer("max_nonlinear_iterations");
@@ -438,7 +442,7 @@ class ThermalPhysics final : public Physics {
     long iteration = 0;
     while (iteration < max_iterations) {
       ++iteration;
-      nodal_chord_capacity(chord, nodal_capacity);
+      nodal_chord_capacity(nodal_capacity);
       // A = diag(V_i C̃_i/Δt) + K ; rhs = f^n ; Dirichlet rows eliminated symmetrically.
       matrix_values_ = stiffness_;
       for (std::size_t i = 0; i < nodes; ++i) {
@@ -447,13 +451,19 @@ class ThermalPhysics final : public Physics {
       }
       eliminate_constraints();
       system_->set_values(matrix_values_);
-      solution = node_dT_;
+      for (std::size_t i = 0; i < nodes; ++i) solution[i] = is_fixed(i) ? constraint_dT_[i] : node_dT_[i];
       const SolveStats stats = system_->solve(rhs_, solution, /*rebuild_preconditioner=*/iteration == 1);
       linear_total_ += stats.iterations;
+      // Chord-capacity Picard can cycle when the front sits on a node; past 10 iterations the
+      // update is under-relaxed, which restores contraction.
+      const double relax = iteration <= 10 ? 1.0 : 0.5;
       double change = 0;
-      for (std::size_t i = 0; i < nodes; ++i) change = std::max(change, std::abs(solution[i] - node_dT_[i]));
-      node_dT_ = solution;
-      if (change <= tolerance && iteration > 1) {
+      for (std::size_t i = 0; i < nodes; ++i) {
+        if (is_fixed(i)) continue;
+        change = std::max(change, std::abs(solution[i] - node_dT_[i]));
+        node_dT_[i] += relax * (solution[i] - node_dT_[i]);
+      }
+      if (change <= tolerance) {
         converged = true;
         break;
       }
@@ -461,10 +471,8 @@ class ThermalPhysics final : public Physics {
     nonlinear_total_ += iteration;
     nonlinear_max_ = std::max(nonlinear_max_, iteration);
     if (!converged) ++unconverged_steps_;
-    // Energy each node gives its particles, consistent with the converged chord capacity.
-    nodal_chord_capacity(chord, nodal_capacity);
-    for (std::size_t i = 0; i < nodes; ++i)
-      node_energy_[i] = node_volume_[i] > 0 ? nodal_capacity[i] * node_dT_[i] : 0.0;
+    // Particle chords consistent with the converged increments.
+    nodal_chord_capacity(nodal_capacity);
   }
 
   /// Rows of Dirichlet and empty nodes become identity; their known values move to the
@@ -474,20 +482,21 @@ class ThermalPhysics final : public Physics {
     const auto& columns = columns_;
     const std::size_t nodes = node_volume_.size();
     for (std::size_t i = 0; i < nodes; ++i) {
-      const bool fixed_row = dirichlet_[i] || node_volume_[i] <= 0;
+      const bool fixed_row = is_fixed(i);
       for (std::size_t e = offsets[i]; e < offsets[i + 1]; ++e) {
         const auto j = static_cast<std::size_t>(columns[e]);
-        const bool fixed_col = dirichlet_[j] || node_volume_[j] <= 0;
+        const bool fixed_col = is_fixed(j);
         if (fixed_row) {
           matrix_values_[e] = i == j ? 1.0 : 0.0;
         } else if (fixed_col) {
-          rhs_[i] -= matrix_values_[e] * node_dT_[j];
+          rhs_[i] -= matrix_values_[e] * constraint_dT_[j];
           matrix_values_[e] = 0.0;
         }
       }
-      if (fixed_row) rhs_[i] = node_dT_[i];
+      if (fixed_row) rhs_[i] = constraint_dT_[i];
     }
   }
+  bool is_fixed(std::size_t i) const { return dirichlet_[i] || node_volume_[i] <= 0; }
   // ---- particles ----------------------------------------------------------------------------
   void map_to_particles() {
     const auto& st = sim_->stencil();
@@ -500,12 +509,15 @@ class ThermalPhysics final : public Physics {
     const auto phi = particles.field("porosity");
     const auto vol = particles.field("volume");
     energy_.resize(n);
+    // Each particle takes the interpolated nodal temperature change at its own chord capacity:
+    // ΔE_p = c_p Σ_i S_ip ΔT_i. Summed over particles this is exactly Σ_i V_i C̃_i ΔT_i, the
+    // energy the nodes gained, and particles in different states cannot drift apart.
     for (std::size_t p = 0; p < n; ++p) {
       const auto* nodes = st.nodes(p);
       const auto* w = st.weights(p);
-      double e = 0;
-      for (int k = 0; k < K; ++k) e += w[k] * node_energy_[nodes[k]];
-      energy_[p] = e;
+      double dT = 0;
+      for (int k = 0; k < K; ++k) dT += w[k] * node_dT_[nodes[k]];
+      energy_[p] = particle_chord_[p] * dT;
     }
     for (const auto& r : particles.ranges()) {
       const int it = invert_heat(*sfcc_[r.material], constants_[r.material], phi.subspan(r.begin, r.size()),
@@ -538,6 +550,19 @@ class ThermalPhysics final : public Physics {
     }
     if (flip_fraction_ < 1.0)
       for (std::size_t p = 0; p < n; ++p) T[p] = flip_fraction_ * T[p] + (1.0 - flip_fraction_) * T_pic[p];
+    // Particles on a Dirichlet node take the PIC value, in which that node holds the prescribed
+    // temperature: a FLIP increment there (target − mean of the node's particles) would push a
+    // particle already at the boundary value past it. The boundary is an energy reservoir, so
+    // nothing is lost that the physics conserves.
+    for (std::size_t p = 0; p < n; ++p) {
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      for (int k = 0; k < K; ++k)
+        if (w[k] > 0 && dirichlet_[nodes[k]]) {
+          T[p] = T_pic[p];
+          break;
+        }
+    }
     apply_particle_dirichlet(time_ + dt_);
     properties_valid_ = false;
   }

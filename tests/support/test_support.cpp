@@ -16,7 +16,12 @@ const Registry& builtin_registry() {
   static Registry registry = [] {
     Registry r;
     PluginLoader loader(r);
+    // Only the built-in folder: a user's FROSTMPM_PLUGIN_PATH must not change what tests see.
+    const char* user_path = std::getenv("FROSTMPM_PLUGIN_PATH");
+    const std::string saved = user_path ? user_path : "";
+    unsetenv("FROSTMPM_PLUGIN_PATH");
     for (const auto& dir : PluginLoader::default_search_path()) loader.load_directory(dir);
+    if (user_path) setenv("FROSTMPM_PLUGIN_PATH", saved.c_str(), 1);
     return r;
   }();
   return registry;

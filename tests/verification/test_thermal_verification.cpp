@@ -1,0 +1,208 @@
+// Verification of the thermal plugin against closed forms (VERIFICATION.md §1): each case at
+// three resolutions and for both time schemes, asserting the error at the finest resolution
+// and the observed convergence order. References: tests/verification/analytic/.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "thermal_harness.hpp"
+#include "verification/analytic/heat_conduction.hpp"
+
+using namespace frostmpm::test;
+namespace an = frostmpm::analytic;
+
+namespace {
+
+constexpr double kDay = 86400.0;
+
+struct LevelResult {
+  double h, dt, rmse, rmse_pic, max_error, front = NAN, t_min, t_max;
+};
+
+template <class Exact>
+LevelResult evaluate(const ColumnSetup& setup, const ColumnRun& run, Exact&& exact, const char* front_probe) {
+  LevelResult r{};
+  r.h = setup.cell;
+  r.dt = run.mean_dt;
+  const auto flip = an::profile_error(run.depth, run.temperature, [&](double x) { return exact(x, kDay); });
+  const auto pic = an::profile_error(run.depth, run.temperature_pic, [&](double x) { return exact(x, kDay); });
+  r.rmse = flip.rmse;
+  r.rmse_pic = pic.rmse;
+  r.max_error = flip.max_abs;
+  if (front_probe) {
+    const auto it = std::find(run.metrics_header.begin(), run.metrics_header.end(), front_probe);
+    REQUIRE(it != run.metrics_header.end());
+    r.front = run.metrics.back()[static_cast<std::size_t>(it - run.metrics_header.begin())];
+    REQUIRE(run.metrics.back()[0] == Approx(kDay));
+  }
+  r.t_min = std::min(*std::min_element(run.temperature.begin(), run.temperature.end()),
+                     *std::min_element(run.temperature_pic.begin(), run.temperature_pic.end()));
+  r.t_max = std::max(*std::max_element(run.temperature.begin(), run.temperature.end()),
+                     *std::max_element(run.temperature_pic.begin(), run.temperature_pic.end()));
+  char line[200];
+  std::snprintf(line, sizeof line, "RMSE flip %.4f pic %.4f max %.4f front %.5f", r.rmse, r.rmse_pic, r.max_error,
+                r.front);
+  WARN(describe(setup, run, line));
+  return r;
+}
+
+/// Runs `base` at the given cell sizes; implicit steps are `implicit_dt(h)`.
+template <class Exact, class Dt>
+std::vector<LevelResult> sweep(ColumnSetup base, const std::vector<double>& cells, Exact&& exact,
+                               const char* front_probe, Dt&& implicit_dt) {
+  std::vector<LevelResult> out;
+  for (double h : cells) {
+    ColumnSetup s = base;
+    s.cell = h;
+    if (s.scheme == "implicit") s.dt = implicit_dt(h);
+    out.push_back(evaluate(s, run_column(s), exact, front_probe));
+  }
+  return out;
+}
+
+double order(const std::vector<LevelResult>& levels, double LevelResult::*error) {
+  return an::observed_order(levels.front().*error, levels.back().*error, levels.front().h, levels.back().h);
+}
+
+// ---- VERIFICATION §1.1: Kurylyk et al. (2014) benchmark 1 --------------------------------------
+an::NeumannSolution neumann_reference() {
+  an::NeumannParams p{};
+  p.k1 = 1.839;  // thawed
+  p.k2 = 2.619;  // frozen
+  p.C1 = 0.5 * 1000 * 4182 + 0.5 * 2500 * 889;
+  p.C2 = 2.169e6;
+  p.L_v = 0.5 * 1000 * 334000;
+  p.Ts = 5;
+  p.Ti = -5;
+  p.Tf = 0;
+  p.s = -1;
+  return an::NeumannSolution(p);
+}
+
+std::vector<LevelResult> neumann(const std::string& scheme) {
+  const auto ref = neumann_reference();
+  ColumnSetup base{"neumann_thaw.yaml", 1.5, 0.01, scheme};
+  auto levels = sweep(base, {0.01, 0.005, 0.0025}, ref, "thaw_depth", [](double) { return 60.0; });
+  const LevelResult& fine = levels.back();
+  const double X = ref.front(kDay);  // 0.08374 m (published 0.0838)
+  INFO("front " << fine.front << " m, analytic " << X << " m");
+  CHECK(std::abs(fine.front - X) <= std::max(0.01 * X, fine.h / 2));
+  CHECK(fine.rmse <= 0.05);
+  CHECK(fine.rmse_pic <= 0.05);
+  // Maximum principle (VERIFICATION §6): no particle temperature leaves [−5, 5] by more than 0.02 °C.
+  CHECK(fine.t_max <= 5.0 + 0.02);
+  CHECK(fine.t_min >= -5.0 - 0.02);
+  // A sharp front converges at about first order.
+  CHECK(order(levels, &LevelResult::rmse) >= 0.4);
+  CHECK(levels.back().rmse < levels.front().rmse);
+  return levels;
+}
+
+}  // namespace
+
+TEST_CASE("Neumann thaw, both schemes: front and profile at 1 d; implicit at >= 20x the explicit step",
+          "[verification][neumann]") {
+  const auto explicit_levels = neumann("explicit");
+  const auto implicit_levels = neumann("implicit");
+  // The explicit step at the finest level is set by diffusion: 0.9 h²/(2·2·α_frozen).
+  const double alpha_frozen = 2.619 / 2.169e6;
+  const double h = implicit_levels.back().h;
+  REQUIRE(explicit_levels.back().dt == Approx(0.9 * h * h / (4 * alpha_frozen)).epsilon(0.01));
+  REQUIRE(implicit_levels.back().dt >= 20 * explicit_levels.back().dt);
+  // ...and is as accurate: within 10 % + 0.005 °C of the explicit RMSE, fronts within h/2.
+  CHECK(implicit_levels.back().rmse <= 1.1 * explicit_levels.back().rmse + 0.005);
+  CHECK(std::abs(implicit_levels.back().front - explicit_levels.back().front) <= h / 2);
+}
+
+// ---- VERIFICATION §1.3: Lunardini three-zone freezing (INTERFROST T1) --------------------------
+namespace {
+
+an::LunardiniSolution lunardini_reference(double Tm) {
+  an::LunardiniParams p{};
+  p.k1 = 3.4644;  // frozen
+  p.k2 = 2.9414;  // mushy
+  p.k3 = 2.4184;  // thawed
+  p.C1 = p.C2 = p.C3 = 690360;
+  p.rho_d = 1680;
+  p.xiF = 0.0782;
+  p.xi0 = 0.2;
+  p.L = 334720;
+  p.Ts = -6;
+  p.T0 = 4;
+  p.Tf = 0;
+  p.Tm = Tm;
+  return an::LunardiniSolution(p);
+}
+
+void lunardini(const std::string& scheme, double Tm) {
+  const auto ref = lunardini_reference(Tm);
+  ColumnSetup base{"lunardini_freezing.yaml", 2.0, 0.04, scheme};
+  base.overrides = {"materials.soil.sfcc.mushy_end=" + std::to_string(Tm)};
+  auto levels = sweep(base, {0.04, 0.02, 0.01}, ref, "thaw_limit", [](double) { return 120.0; });
+  const LevelResult& fine = levels.back();
+  INFO("Tm = " << Tm << ": X2(1 d) analytic " << ref.front_thawed(kDay) << " m, simulated " << fine.front << " m");
+  // Acceptance (issue #3): RMSE ≤ 0.1 °C and max error ≤ 0.5 °C at 1 d.
+  CHECK(fine.rmse <= 0.1);
+  CHECK(fine.max_error <= 0.5);
+  CHECK(std::abs(fine.front - ref.front_thawed(kDay)) <= std::max(0.01 * ref.front_thawed(kDay), fine.h));
+  CHECK(fine.t_max <= 4.0 + 0.02);
+  CHECK(fine.t_min >= -6.0 - 0.02);
+  CHECK(order(levels, &LevelResult::rmse) >= 0.8);
+}
+
+}  // namespace
+
+TEST_CASE("Lunardini mushy-zone freezing, Tm = -1 degC, explicit (VERIFICATION 1.3)", "[verification][lunardini]") {
+  lunardini("explicit", -1.0);
+}
+TEST_CASE("Lunardini mushy-zone freezing, Tm = -1 degC, implicit", "[verification][lunardini]") {
+  lunardini("implicit", -1.0);
+}
+TEST_CASE("Lunardini mushy-zone freezing, Tm = -4 degC, explicit", "[verification][lunardini]") {
+  lunardini("explicit", -4.0);
+}
+TEST_CASE("Lunardini mushy-zone freezing, Tm = -4 degC, implicit", "[verification][lunardini]") {
+  lunardini("implicit", -4.0);
+}
+
+// ---- Conduction without phase change: erf and Carslaw–Jaeger convective surface -------------
+namespace {
+
+// Diffusivity of the thawed Neumann material (conduction_erf.yaml / convective_surface.yaml).
+constexpr double kConductivity = 1.839;
+constexpr double kCapacity = 0.5 * 1000 * 4182 + 0.5 * 2500 * 889;
+constexpr double kAlpha = kConductivity / kCapacity;
+
+/// Implicit steps shrink with h² (20× the explicit limit) so the time error (first order)
+/// follows the space error and the observed order is the scheme's.
+double implicit_step(double h) { return 20 * 0.9 * h * h / (4 * kAlpha); }
+
+template <class Exact>
+void smooth_case(const std::string& scene, const std::string& scheme, Exact&& exact, double finest_rmse) {
+  ColumnSetup base{scene, 1.0, 0.02, scheme};
+  auto levels = sweep(base, {0.02, 0.01, 0.005}, exact, nullptr, implicit_step);
+  CHECK(levels.back().rmse <= finest_rmse);
+  const double p = order(levels, &LevelResult::rmse);
+  INFO("observed order " << p);
+  // Linear-basis GIMP on a smooth solution: second order in space; backward Euler with
+  // Δt ∝ h² keeps that.
+  CHECK(p >= 1.7);
+}
+
+}  // namespace
+
+TEST_CASE("conduction without phase change matches the erf solution, both schemes", "[verification][conduction]") {
+  const an::SemiInfiniteStep exact{kAlpha, 20.0, 10.0};
+  for (const char* scheme : {"explicit", "implicit"}) {
+    SECTION(scheme) { smooth_case("conduction_erf.yaml", scheme, exact, 0.01); }
+  }
+}
+
+TEST_CASE("convective surface matches Carslaw-Jaeger, both schemes", "[verification][convective]") {
+  const an::SemiInfiniteConvective exact{kConductivity, kAlpha, 20.0, 20.0, 10.0};
+  for (const char* scheme : {"explicit", "implicit"}) {
+    SECTION(scheme) { smooth_case("convective_surface.yaml", scheme, exact, 0.01); }
+  }
+}
