@@ -1,0 +1,123 @@
+// README command (1): the default scene, INTERFROST TH2 without flow (frozen inclusion thawing
+// by conduction). Checks what a user gets: the thaw time against the 13-code range, the liquid
+// volume against the benchmark's PM3 values, a maximum principle, a thermal-only field set and
+// stage list, and fields.xdmf + fields.h5 read back by a real reader.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <sstream>
+
+#include "test_support.hpp"
+
+using namespace frostmpm::test;
+
+namespace {
+std::vector<std::vector<double>> read_metrics(const std::string& path, std::vector<std::string>& header) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::stringstream hs(line);
+  for (std::string cell; std::getline(hs, cell, ',');) header.push_back(cell);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
+    rows.push_back(row);
+  }
+  return rows;
+}
+std::size_t column(const std::vector<std::string>& header, const std::string& name) {
+  const auto it = std::find(header.begin(), header.end(), name);
+  REQUIRE(it != header.end());
+  return static_cast<std::size_t>(it - header.begin());
+}
+}  // namespace
+
+TEST_CASE("default scene: frozen inclusion thaws within the INTERFROST range", "[default-scene]") {
+  TempDir dir;
+  const auto r = run_frostmpm("run " + source_dir() + "/configs/tutorials/frozen_inclusion.yaml -o " + dir.file("out"));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+
+  std::vector<std::string> header;
+  const auto rows = read_metrics(dir.file("out/metrics.csv"), header);
+  const auto t_min = column(header, "T_min"), t_max = column(header, "T_max");
+  const auto volume = column(header, "liquid_volume_m3");
+  // PM3 (Grenier et al. 2018): 1.0710 m³ of liquid per metre at t = 0, 1.1100 m³ thawed.
+  CHECK(rows.front()[volume] == Approx(1.0710).margin(5e-4));
+  CHECK(rows.back()[volume] == Approx(1.1100).margin(5e-4));
+  // PM1: the time T_min rises above 0 °C. INTERFROST 0 % gradient: 32.4–41.7 h over 13 codes.
+  double thaw_hours = -1;
+  for (const auto& row : rows)
+    if (row[t_min] > 0) {
+      thaw_hours = row[0] / 3600.0;
+      break;
+    }
+  INFO("thaw time " << thaw_hours << " h");
+  CHECK(thaw_hours >= 32.4);
+  CHECK(thaw_hours <= 41.7);
+  // Maximum principle: no source, so T stays within [−5, 5] °C.
+  for (const auto& row : rows) {
+    CHECK(row[t_min] >= -5.0 - 1e-9);
+    CHECK(row[t_max] <= 5.0 + 1e-9);
+  }
+}
+
+TEST_CASE("a thermal-only run allocates no hydraulic or mechanical fields and runs only thermal stages",
+          "[default-scene]") {
+  TempDir dir;
+  const auto r = run_frostmpm("run " + source_dir() + "/configs/tutorials/frozen_inclusion.yaml -o " +
+                              dir.file("out") + " --set time.end=3600");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  // run.json read with a real JSON parser: fields allocated and stages run.
+  const auto py = run_command("/usr/bin/python3 -c \"import json; r=json.load(open('" + dir.file("out/run.json") +
+                              "'))['run']; print(' '.join(r['particle_fields'])); print(' '.join(r['stage_wall_seconds']))\"");
+  INFO(py.output);
+  REQUIRE(py.exit_code == 0);
+  std::stringstream lines(py.output);
+  std::string fields, stages;
+  std::getline(lines, fields);
+  std::getline(lines, stages);
+  for (const char* absent : {"pressure", "velocity", "stress", "displacement", "strain"}) {
+    INFO(absent);
+    CHECK(fields.find(absent) == std::string::npos);
+  }
+  CHECK(fields.find("temperature") != std::string::npos);
+  std::stringstream names(stages);
+  std::size_t count = 0;
+  for (std::string name; names >> name; ++count) {
+    INFO(name);
+    CHECK((name.rfind("thermal.", 0) == 0 || name.rfind("kernel.", 0) == 0));
+  }
+  CHECK(count >= 4);
+}
+
+TEST_CASE("fields.xdmf and fields.h5 load in a real reader with the values written", "[default-scene][io]") {
+  TempDir dir;
+  const auto r = run_frostmpm("run " + source_dir() + "/configs/tutorials/frozen_inclusion.yaml -o " +
+                              dir.file("out") + " --set time.end=7200");
+  REQUIRE(r.exit_code == 0);
+  // The reader parses the XDMF, opens every DataItem with h5py, checks shapes, and prints the
+  // last frame's temperature range; it must equal the T_min/T_max the run recorded itself.
+  const auto py = run_command("/usr/bin/python3 -c \"\nimport json,subprocess,sys\n"
+                              "s=json.loads(subprocess.check_output([sys.executable,'" + source_dir() +
+                              "/scripts/read_fields.py','" + dir.file("out") + "','--dump']))\n"
+                              "import numpy as np\n"
+                              "f=s['frames'][-1]\n"
+                              "T=np.array(f['fields']['temperature']['values'],dtype=float).ravel()\n"
+                              "print(len(s['frames']), repr(T.min()), repr(T.max()), f['time'])\n\"");
+  INFO(py.output);
+  REQUIRE(py.exit_code == 0);
+  std::stringstream ss(py.output);
+  double frames = 0, low = 0, high = 0, time = 0;
+  ss >> frames >> low >> high >> time;
+  CHECK(frames == 2);  // t = 0 and t = 7200 s (output every 7200 s)
+  CHECK(time == 7200);
+  std::vector<std::string> header;
+  const auto rows = read_metrics(dir.file("out/metrics.csv"), header);
+  // metrics.csv carries 12 significant digits.
+  CHECK(low == Approx(rows.back()[column(header, "T_min")]).epsilon(1e-10));
+  CHECK(high == Approx(rows.back()[column(header, "T_max")]).epsilon(1e-10));
+}
