@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 #include "frostmpm/linalg/sparse_system.hpp"
@@ -456,6 +457,7 @@ class ThermalPhysics final : public Physics {
         rhs_[i] = node_volume_[i] > 0 ? node_force_[i] : 0.0;
       }
       eliminate_constraints();
+      check_finite_system();
       system_->set_values(matrix_values_);
       for (std::size_t i = 0; i < nodes; ++i) solution[i] = is_fixed(i) ? constraint_dT_[i] : node_dT_[i];
       const SolveStats stats = system_->solve(rhs_, solution, /*rebuild_preconditioner=*/iteration == 1);
@@ -503,6 +505,20 @@ class ThermalPhysics final : public Physics {
     }
   }
   bool is_fixed(std::size_t i) const { return dirichlet_[i] || node_volume_[i] <= 0; }
+
+  /// A non-finite right-hand side (e.g. a boundary value that became NaN) stops the run with
+  /// the node, time and step rather than reaching the linear solver.
+  void check_finite_system() const {
+    for (std::size_t i = 0; i < rhs_.size(); ++i)
+      if (!std::isfinite(rhs_[i]) || !std::isfinite(matrix_values_[diagonal_[i]])) {
+        const auto x = sim_->grid().node_position(i);
+        std::ostringstream msg;
+        msg << "numerical blow-up: temperature equation not finite at grid node " << i << " (x = " << x[0]
+            << ", y = " << x[1] << ") at t = " << time_ << " s, step " << sim_->step() << " (dt = " << dt_
+            << " s); check boundary values and material parameters";
+        throw NumericalBlowUp(msg.str());
+      }
+  }
   // ---- particles ----------------------------------------------------------------------------
   void map_to_particles() {
     const auto& st = sim_->stencil();

@@ -240,3 +240,33 @@ TEST_CASE("a failed run leaves an earlier complete output untouched", "[cli][bad
   REQUIRE(r.exit_code == 2);
   REQUIRE(read_file(dir.file("out/freezing_curves.csv")) == before);
 }
+
+TEST_CASE("bad input found inside plugin code exits 2 with the YAML location", "[cli][bad-input]") {
+  // The linear SFCC checks mushy_end < freezing_point in its constructor (plugin code).
+  TempDir dir;
+  const auto r = run_bad(dir, replace(kGoodScene, "    model: van_genuchten_cc\n    lambda: 0.5\n    p0: 1.0e5\n",
+                                      "    model: linear\n    mushy_end: 1.0\n    residual_saturation: 0.1\n"));
+  REQUIRE(r.output.find("material.sfcc.mushy_end") != std::string::npos);
+  REQUIRE(r.output.find("mushy_end must be below freezing_point") != std::string::npos);
+}
+
+TEST_CASE("a numerical blow-up stops with where and when, exit 3, earlier output readable", "[cli][blow-up]") {
+  TempDir dir;
+  // A boundary value that becomes NaN after one hour.
+  const std::string scene = read_file(source_dir() + "/configs/tutorials/frozen_inclusion.yaml");
+  write_file(dir.file("scene.yaml"), scene);
+  const auto r = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + dir.file("out") +
+                              " --set time.end=14400 --set output.every=3600"
+                              " --set 'boundary_conditions.0.value={expression: \"if(t > 7000, log(-1), 5)\"}'");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 3);
+  REQUIRE(r.output.find("numerical blow-up: temperature") != std::string::npos);
+  REQUIRE(r.output.find("step ") != std::string::npos);
+  REQUIRE(r.output.find("at t = ") != std::string::npos);
+  REQUIRE(r.output.find("(x = ") != std::string::npos);
+  // Frames at t = 0 and 3600 s were written before the blow-up and still read.
+  const auto py = run_command("/usr/bin/python3 " + source_dir() + "/scripts/read_fields.py " + dir.file("out"));
+  INFO(py.output);
+  REQUIRE(py.exit_code == 0);
+  REQUIRE(py.output.find("3600") != std::string::npos);
+}
