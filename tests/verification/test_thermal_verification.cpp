@@ -232,3 +232,34 @@ TEST_CASE("convective surface matches Carslaw-Jaeger, both schemes", "[verificat
     SECTION(scheme) { smooth_case("convective_surface.yaml", scheme, exact, 0.01); }
   }
 }
+
+TEST_CASE("prescribed heat flux: Carslaw-Jaeger profile and exact energy balance, both schemes",
+          "[verification][heat-flux]") {
+  const double q = 50.0;
+  const auto exact = [&](double x, double t) {
+    const double s = std::sqrt(kAlpha * t);
+    return 10.0 + 2 * q / kConductivity *
+                      (s / std::sqrt(M_PI) * std::exp(-x * x / (4 * s * s)) - 0.5 * x * std::erfc(x / (2 * s)));
+  };
+  for (const char* scheme : {"explicit", "implicit"}) {
+    SECTION(scheme) {
+      ColumnSetup base{"heat_flux.yaml", 2.0, 0.02, scheme};
+      std::vector<LevelResult> levels;
+      for (double h : {0.02, 0.01, 0.005}) {
+        ColumnSetup s = base;
+        s.cell = h;
+        if (s.scheme == "implicit") s.dt = implicit_step(h);
+        const ColumnRun run = run_column(s);
+        levels.push_back(evaluate(s, run, exact, nullptr, 2.0));
+        // Energy: every joule that entered through the face is in the particles, to round-off.
+        // Particle volume h²/4 (2×2 per cell, unit thickness), C constant, no latent heat.
+        double stored = 0;
+        for (double T : run.temperature) stored += (h * h / 4) * kCapacity * (T - 10.0);
+        const double entered = q * h * kDay;  // face of width h
+        CHECK(stored == Approx(entered).epsilon(1e-9));
+      }
+      CHECK(levels.back().rmse <= 0.01);
+      CHECK(order(levels, &LevelResult::rmse) >= 1.4);
+    }
+  }
+}

@@ -1,0 +1,115 @@
+// Shape functions, the stencil cache and particle generation by regions.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "frostmpm/config/config_node.hpp"
+#include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/scene/region.hpp"
+#include "frostmpm/shape/stencil_cache.hpp"
+
+using namespace frostmpm;
+
+namespace {
+UniformGrid<2> make_grid(ShapeKind kind) {
+  UniformGrid<2> g;
+  g.origin = {0.0, 0.0};
+  g.spacing = {0.1, 0.2};
+  g.cells = {10, 5};
+  g.ghost_layers = ghost_layers(kind);
+  return g;
+}
+}  // namespace
+
+TEST_CASE("shape functions: partition of unity, zero gradient sum, linear reproduction", "[shape]") {
+  for (ShapeKind kind : {ShapeKind::Linear, ShapeKind::Gimp, ShapeKind::CubicBSpline}) {
+    INFO(to_string(kind));
+    const auto grid = make_grid(kind);
+    StencilCache<2> cache;
+    cache.configure(kind);
+    // Particles away from the domain edge (B-splines are complete only there).
+    std::vector<double> pos, half;
+    for (double x = 0.23; x < 0.8; x += 0.0371)
+      for (double y = 0.31; y < 0.7; y += 0.0533) {
+        pos.insert(pos.end(), {x, y});
+        half.insert(half.end(), {0.025, 0.05});
+      }
+    REQUIRE(cache.update(grid, pos, half) == -1);
+    const int K = cache.per_particle();
+    for (std::size_t p = 0; p < pos.size() / 2; ++p) {
+      double sum = 0, gx = 0, gy = 0, rx = 0, ry = 0, drx = 0, dry = 0;
+      for (int k = 0; k < K; ++k) {
+        const auto xi = grid.node_position(cache.nodes(p)[k]);
+        const double w = cache.weights(p)[k];
+        sum += w;
+        gx += cache.gradients(p)[2 * k];
+        gy += cache.gradients(p)[2 * k + 1];
+        rx += w * xi[0];
+        ry += w * xi[1];
+        drx += cache.gradients(p)[2 * k] * xi[0];  // ∇ of the reproduced x: must be (1, 0)
+        dry += cache.gradients(p)[2 * k + 1] * xi[1];
+      }
+      REQUIRE(sum == Approx(1.0).margin(1e-12));
+      REQUIRE(gx == Approx(0.0).margin(1e-9));
+      REQUIRE(gy == Approx(0.0).margin(1e-9));
+      REQUIRE(rx == Approx(pos[2 * p]).margin(1e-12));
+      REQUIRE(ry == Approx(pos[2 * p + 1]).margin(1e-12));
+      REQUIRE(drx == Approx(1.0).margin(1e-9));
+      REQUIRE(dry == Approx(1.0).margin(1e-9));
+    }
+  }
+}
+
+TEST_CASE("GIMP weights match the closed form of Bardenhagen & Kober", "[shape]") {
+  double w[3], g[3];
+  // Particle at the node (xi = 3), half-width lp = 0.25 cells: S = 1 − lp/2 at the node and
+  // (h + lp − |r|)²/(4 h lp) = 0.25²/1 = 0.0625 at the neighbours... ((1.25 − 1)² / (4·0.25)).
+  const int base = shape_1d(ShapeKind::Gimp, 3.0, 1.0, 0.25, w, g);
+  REQUIRE(base == 2);
+  REQUIRE(w[1] == Approx(1 - 0.25 / 2));
+  REQUIRE(w[0] == Approx(0.0625));
+  REQUIRE(w[2] == Approx(0.0625));
+  REQUIRE(g[1] == Approx(0.0));
+}
+
+TEST_CASE("a particle outside the grid is reported by the stencil cache", "[shape]") {
+  const auto grid = make_grid(ShapeKind::Linear);
+  StencilCache<2> cache;
+  cache.configure(ShapeKind::Linear);
+  std::vector<double> pos = {0.5, 0.5, 1.5, 0.5}, half = {0.025, 0.05, 0.025, 0.05};
+  REQUIRE(cache.update(grid, pos, half) == 1);
+}
+
+TEST_CASE("regions: box, disk, half-disk and polygon fill their area with n×n particles per cell", "[regions]") {
+  UniformGrid<2> grid;
+  grid.spacing = {0.01, 0.01};
+  grid.cells = {200, 200};
+  const double particle_area = 0.01 * 0.01 / 4;  // 2×2 per cell
+  struct Case {
+    std::string yaml;
+    double area;
+  };
+  const double pi = std::acos(-1.0);
+  for (const Case& c : {Case{"box: {min: [0.2, 0.3], max: [1.2, 0.8]}", 0.5},
+                        Case{"disk: {center: [1.0, 1.0], radius: 0.5}", pi * 0.25},
+                        Case{"half_disk: {center: [1.0, 1.0], radius: 0.5, side: top}", pi * 0.125},
+                        Case{"polygon: [[0.1, 0.1], [1.1, 0.1], [0.1, 1.1]]", 0.5}}) {
+    INFO(c.yaml);
+    const auto node = ConfigNode::load_string(c.yaml);
+    const auto shape = read_region_shape(node);
+    const auto points = sample_region(grid, shape, 2);
+    // Area within one row of particles along the boundary.
+    REQUIRE(points.size() * particle_area == Approx(c.area).epsilon(0.02));
+    for (const auto& p : points) REQUIRE(shape.contains(p));
+  }
+}
+
+TEST_CASE("regions: a bad shape names the YAML path and the valid shapes", "[regions]") {
+  const auto node = ConfigNode::load_string("circle: {center: [0, 0], radius: 1}");
+  try {
+    read_region_shape(node);
+    FAIL("expected an InputError");
+  } catch (const InputError& e) {
+    REQUIRE(std::string(e.what()).find("box, disk, half_disk, polygon") != std::string::npos);
+  }
+}
