@@ -47,20 +47,6 @@ std::string replace(std::string text, const std::string& from, const std::string
   return text.replace(pos, from.size(), to);
 }
 
-std::vector<std::vector<double>> read_csv(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 }  // namespace
 
 TEST_CASE("default tutorial scene writes the CSV table, the PNG plot and run.json", "[cli]") {
@@ -68,7 +54,7 @@ TEST_CASE("default tutorial scene writes the CSV table, the PNG plot and run.jso
   const auto r = run_frostmpm("run " + source_dir() + "/configs/tutorials/freezing_curves.yaml -o " + dir.file("out"));
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
-  const auto rows = read_csv(dir.file("out/freezing_curves.csv"));
+  const auto rows = read_csv(dir.file("out/freezing_curves.csv")).rows;
   REQUIRE(rows.size() == 601);
   REQUIRE(rows.front()[0] == Approx(-5.0));
   REQUIRE(rows.back()[1] == 1.0);  // thawed at +1 degC
@@ -89,8 +75,8 @@ TEST_CASE("swapping the SFCC model in YAML changes the output with nothing rebui
                               " --set 'material.sfcc={model: exponential, width: 0.5, residual_saturation: 0.05}'");
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
-  const auto a = read_csv(dir.file("a/freezing_curves.csv"));
-  const auto b = read_csv(dir.file("b/freezing_curves.csv"));
+  const auto a = read_csv(dir.file("a/freezing_curves.csv")).rows;
+  const auto b = read_csv(dir.file("b/freezing_curves.csv")).rows;
   REQUIRE(a.size() == b.size());
   // Row 4 is T = -1 degC: van Genuchten-CC gives 0.0887, the Gaussian 0.05 + 0.95 e^-4.
   REQUIRE(a[4][0] == Approx(-1.0));

@@ -11,28 +11,6 @@
 
 using namespace frostmpm::test;
 
-namespace {
-std::vector<std::vector<double>> read_metrics(const std::string& path, std::vector<std::string>& header) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::stringstream hs(line);
-  for (std::string cell; std::getline(hs, cell, ',');) header.push_back(cell);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
-    rows.push_back(row);
-  }
-  return rows;
-}
-std::size_t column(const std::vector<std::string>& header, const std::string& name) {
-  const auto it = std::find(header.begin(), header.end(), name);
-  REQUIRE(it != header.end());
-  return static_cast<std::size_t>(it - header.begin());
-}
-}  // namespace
 
 TEST_CASE("default scene: frozen inclusion thaws within the INTERFROST range", "[default-scene]") {
   TempDir dir;
@@ -40,10 +18,10 @@ TEST_CASE("default scene: frozen inclusion thaws within the INTERFROST range", "
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
 
-  std::vector<std::string> header;
-  const auto rows = read_metrics(dir.file("out/metrics.csv"), header);
-  const auto t_min = column(header, "T_min"), t_max = column(header, "T_max");
-  const auto volume = column(header, "liquid_volume_m3");
+  const CsvTable metrics = read_csv(dir.file("out/metrics.csv"));
+  const auto& rows = metrics.rows;
+  const auto t_min = metrics.column("T_min"), t_max = metrics.column("T_max");
+  const auto volume = metrics.column("liquid_volume_m3");
   // PM3 (Grenier et al. 2018): 1.0710 m³ of liquid per metre at t = 0, 1.1100 m³ thawed.
   CHECK(rows.front()[volume] == Approx(1.0710).margin(5e-4));
   CHECK(rows.back()[volume] == Approx(1.1100).margin(5e-4));
@@ -115,9 +93,8 @@ TEST_CASE("fields.xdmf and fields.h5 load in a real reader with the values writt
   ss >> frames >> low >> high >> time;
   CHECK(frames == 2);  // t = 0 and t = 7200 s (output every 7200 s)
   CHECK(time == 7200);
-  std::vector<std::string> header;
-  const auto rows = read_metrics(dir.file("out/metrics.csv"), header);
+  const CsvTable metrics = read_csv(dir.file("out/metrics.csv"));
   // metrics.csv carries 12 significant digits.
-  CHECK(low == Approx(rows.back()[column(header, "T_min")]).epsilon(1e-10));
-  CHECK(high == Approx(rows.back()[column(header, "T_max")]).epsilon(1e-10));
+  CHECK(low == Approx(metrics.rows.back()[metrics.column("T_min")]).epsilon(1e-10));
+  CHECK(high == Approx(metrics.rows.back()[metrics.column("T_max")]).epsilon(1e-10));
 }

@@ -55,6 +55,28 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+std::size_t CsvTable::column(const std::string& name) const {
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return i;
+  throw std::out_of_range("no column '" + name + "' in the CSV");
+}
+
+CsvTable read_csv(const std::string& path) {
+  CsvTable table;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::stringstream header(line);
+  for (std::string cell; std::getline(header, cell, ',');) table.header.push_back(cell);
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
+    table.rows.push_back(row);
+  }
+  return table;
+}
+
 void write_file(const std::string& path, const std::string& text) {
   std::ofstream out(path);
   out << text;

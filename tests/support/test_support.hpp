@@ -2,6 +2,7 @@
 // Shared helpers for tests: the registry with the built-in plugins loaded, paths into the
 // source and build trees, and running the frostmpm CLI as a user would.
 #include <string>
+#include <vector>
 
 #include "frostmpm/plugin/registry.hpp"
 
@@ -36,6 +37,15 @@ class TempDir {
  private:
   std::string path_;
 };
+
+/// A numeric CSV file with a header line (metrics.csv, freezing_curves.csv).
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  /// Index of a column; throws std::out_of_range naming it when absent.
+  std::size_t column(const std::string& name) const;
+};
+CsvTable read_csv(const std::string& path);
 
 /// Writes `text` to `path`.
 void write_file(const std::string& path, const std::string& text);

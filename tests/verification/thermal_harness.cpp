@@ -44,17 +44,9 @@ ColumnRun run_column(const ColumnSetup& s) {
     run.temperature.push_back(T[p]);
     run.temperature_pic.push_back(Tp[p]);
   }
-  std::ifstream csv(dir.file("metrics.csv"));
-  std::string line;
-  std::getline(csv, line);
-  std::stringstream header(line);
-  for (std::string cell; std::getline(header, cell, ',');) run.metrics_header.push_back(cell);
-  while (std::getline(csv, line)) {
-    std::vector<double> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
-    run.metrics.push_back(row);
-  }
+  const CsvTable metrics = read_csv(dir.file("metrics.csv"));
+  run.metrics_header = metrics.header;
+  run.metrics = metrics.rows;
   return run;
 }
 
