@@ -84,7 +84,7 @@ TEST_CASE("swapping the SFCC model in YAML changes the output with nothing rebui
   REQUIRE(b[4][1] == Approx(0.05 + 0.95 * std::exp(-4.0)).epsilon(1e-9));
 }
 
-TEST_CASE("--set overrides a scalar and check prints the resolved scene with defaults", "[cli]") {
+TEST_CASE("check with --set overrides a scalar and prints the resolved scene with defaults", "[cli]") {
   TempDir dir;
   write_file(dir.file("scene.yaml"), kGoodScene);
   const auto r = run_frostmpm("check " + dir.file("scene.yaml") + " --set material.sfcc.lambda=0.25");
@@ -95,7 +95,7 @@ TEST_CASE("--set overrides a scalar and check prints the resolved scene with def
   REQUIRE(r.output.find("pore_pressure: 0") != std::string::npos);
 }
 
-TEST_CASE("plugins lists the built-in models with their libraries; describe shows schemas", "[cli]") {
+TEST_CASE("plugins lists the built-in models with their libraries, describe shows schemas", "[cli]") {
   const auto r = run_frostmpm("plugins");
   REQUIRE(r.exit_code == 0);
   for (const char* name : {"van_genuchten_cc", "exponential", "power_law", "linear", "van_genuchten_mualem",
@@ -177,7 +177,7 @@ TEST_CASE("bad input: a plugin with the wrong ABI tag is refused naming both tag
   REQUIRE(r.output.find("frostmpm-abi-1") != std::string::npos);
 }
 
-TEST_CASE("refused libraries found in a plugin folder are warnings; the rest still load", "[cli]") {
+TEST_CASE("refused libraries found in a plugin folder are warnings, the rest still load", "[cli]") {
   // The fixture folder holds both refusable libraries; the built-in models still work.
   TempDir dir;
   write_file(dir.file("scene.yaml"), "plugin_paths: [" + binary_dir() + "/test-fixtures]\n" + kGoodScene);

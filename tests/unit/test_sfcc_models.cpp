@@ -220,7 +220,7 @@ TEST_CASE("SFCC models tend to the residual saturation far below freezing", "[sf
   CHECK(eval(*vgcc, -50.0, 0.0).S > 0.0);
 }
 
-TEST_CASE("SFCC models are monotone in temperature and bounded by [S_res, 1]", "[sfcc]") {
+TEST_CASE("SFCC models are monotone in temperature and bounded by S_res and 1", "[sfcc]") {
   const auto& registry = frostmpm::test::builtin_registry();
   const auto sweep = linspace(-250.0, 5.0, 25501);  // 0.01 °C steps
   for (const auto* entry : registry.entries(SfccModel::kKind)) {
@@ -245,7 +245,7 @@ TEST_CASE("SFCC models are monotone in temperature and bounded by [S_res, 1]", "
   }
 }
 
-TEST_CASE("SFCC batch evaluation equals pointwise evaluation; empty pressure means zero", "[sfcc]") {
+TEST_CASE("SFCC batch evaluation equals pointwise evaluation, empty pressure means zero", "[sfcc]") {
   const auto& registry = frostmpm::test::builtin_registry();
   const std::vector<double> T = {-40.0, -7.5, -2.0, -0.6, -0.05, 0.0, 0.4, 3.0};
   const std::vector<double> zeros(T.size(), 0.0);

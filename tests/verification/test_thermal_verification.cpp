@@ -113,7 +113,7 @@ std::vector<LevelResult> neumann(const std::string& scheme) {
 
 }  // namespace
 
-TEST_CASE("Neumann thaw, both schemes: front and profile at 1 d; implicit at >= 20x the explicit step",
+TEST_CASE("Neumann thaw, both schemes: front and profile at 1 d, implicit at 20x the explicit step or more",
           "[verification][neumann]") {
   const auto explicit_levels = neumann("explicit");
   const auto implicit_levels = neumann("implicit");
