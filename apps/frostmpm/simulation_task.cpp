@@ -1,6 +1,8 @@
 // `task: simulation` — a material point simulation: the kernel plus the scene's physics.
 #include <sys/resource.h>
 
+#include <iostream>
+
 #include "frostmpm/simulation/simulation.hpp"
 #include "task.hpp"
 
@@ -16,6 +18,13 @@ class SimulationTask final : public Task {
   void execute(const OutputDir& out) override {
     const bool progress = sim_.resolved()["output"]["progress"].as<bool>();
     sim_.run(out, progress);
+    // Counters named *unconverged* flag steps whose iteration hit its cap; say so, not just
+    // in run.json.
+    for (const auto& physics : sim_.physics())
+      for (const auto& [key, value] : physics->statistics())
+        if (key.find("unconverged") != std::string::npos && value > 0)
+          std::cerr << "warning: " << key << " = " << value << " of " << sim_.statistics().steps
+                    << " steps (see run.json; a smaller time.dt or a looser tolerance helps)\n";
   }
 
   YAML::Node summary() const override {

@@ -463,8 +463,8 @@ class ThermalPhysics final : public Physics {
       const SolveStats stats = system_->solve(rhs_, solution, /*rebuild_preconditioner=*/iteration == 1);
       linear_total_ += stats.iterations;
       // Chord-capacity Picard can cycle when the front sits on a node; past 10 iterations the
-      // update is under-relaxed, which restores contraction.
-      const double relax = iteration <= 10 ? 1.0 : 0.5;
+      // update is under-relaxed (0.5, then 0.25 past 30), which restores contraction.
+      const double relax = iteration <= 10 ? 1.0 : iteration <= 30 ? 0.5 : 0.25;
       double change = 0;
       for (std::size_t i = 0; i < nodes; ++i) {
         if (is_fixed(i)) continue;
