@@ -230,13 +230,14 @@ class ThermalPhysics final : public Physics {
     properties_valid_ = true;
   }
 
-  /// Capacity-weighted nodal temperature (Algorithm 1, line 7) and nodal volume.
-  void map_to_grid() {
+  /// T_i = Σ_p V_p C_p S_ip T_p / Σ_p V_p C_p S_ip (Algorithm 1, line 7) into node_T_, the
+  /// denominator into node_capacity_, and optionally V_i = Σ_p V_p S_ip into node_volume_.
+  void capacity_weighted_nodal_temperature(bool with_volume) {
     const auto& st = sim_->stencil();
     const auto& particles = sim_->particles();
     const auto T = particles.field("temperature");
     const auto vol = particles.field("volume");
-    std::fill(node_volume_.begin(), node_volume_.end(), 0.0);
+    if (with_volume) std::fill(node_volume_.begin(), node_volume_.end(), 0.0);
     std::fill(node_T_.begin(), node_T_.end(), 0.0);
     std::fill(node_capacity_.begin(), node_capacity_.end(), 0.0);
     const int K = st.per_particle();
@@ -245,13 +246,18 @@ class ThermalPhysics final : public Physics {
       const auto* w = st.weights(p);
       const double vc = vol[p] * capacity_[p];
       for (int k = 0; k < K; ++k) {
-        node_volume_[nodes[k]] += vol[p] * w[k];
+        if (with_volume) node_volume_[nodes[k]] += vol[p] * w[k];
         node_capacity_[nodes[k]] += vc * w[k];
         node_T_[nodes[k]] += vc * w[k] * T[p];
       }
     }
     for (std::size_t i = 0; i < node_T_.size(); ++i)
       node_T_[i] = node_capacity_[i] > 0 ? node_T_[i] / node_capacity_[i] : 0.0;
+  }
+
+  /// Capacity-weighted nodal temperature and nodal volume; Dirichlet nodes marked.
+  void map_to_grid() {
+    capacity_weighted_nodal_temperature(/*with_volume=*/true);
     // Dirichlet nodes: the prescribed value now, and the target at the end of the step.
     std::fill(dirichlet_.begin(), dirichlet_.end(), 0);
     for (const auto& bc : fixed_T_) {
@@ -549,19 +555,8 @@ class ThermalPhysics final : public Physics {
     }
     if (subgrid_relaxation_ > 0) subgrid_exchange();
     // PIC temperature (Eq. 65) from the capacity-weighted nodal temperature at t^{n+1}.
-    std::fill(node_T_.begin(), node_T_.end(), 0.0);
-    std::fill(node_capacity_.begin(), node_capacity_.end(), 0.0);
-    for (std::size_t p = 0; p < n; ++p) {
-      const auto* nodes = st.nodes(p);
-      const auto* w = st.weights(p);
-      const double vc = vol[p] * capacity_[p];
-      for (int k = 0; k < K; ++k) {
-        node_capacity_[nodes[k]] += vc * w[k];
-        node_T_[nodes[k]] += vc * w[k] * T[p];
-      }
-    }
+    capacity_weighted_nodal_temperature(/*with_volume=*/false);
     for (std::size_t i = 0; i < node_T_.size(); ++i) {
-      node_T_[i] = node_capacity_[i] > 0 ? node_T_[i] / node_capacity_[i] : 0.0;
       if (dirichlet_[i]) node_T_[i] = dirichlet_target_[i];
     }
     for (std::size_t p = 0; p < n; ++p) {
@@ -606,31 +601,16 @@ class ThermalPhysics final : public Physics {
     const auto vol = particles.field("volume");
     const double h = sim_->grid().min_spacing();
     const double gamma = 1.0 - std::exp(-dt_ * max_diffusivity_ / (subgrid_relaxation_ * h * h));
-    // Weights: the sensible capacity. With the latent peak in the weights, the few particles
-    // inside the freezing window would dominate the mean and pull heat across a sharp front.
-    for (const auto& r : particles.ranges()) {
-      const auto& pc = constants_[r.material];
-      for (std::size_t p = r.begin; p < r.end; ++p) particle_chord_[p] = pc.capacity(phi[p], S[p]);
-    }
-    std::fill(node_T_.begin(), node_T_.end(), 0.0);
-    std::fill(node_capacity_.begin(), node_capacity_.end(), 0.0);
-    for (std::size_t p = 0; p < n; ++p) {
-      const auto* nodes = st.nodes(p);
-      const auto* w = st.weights(p);
-      const double vc = vol[p] * particle_chord_[p];
-      for (int k = 0; k < K; ++k) {
-        node_capacity_[nodes[k]] += vc * w[k];
-        node_T_[nodes[k]] += vc * w[k] * T[p];
-      }
-    }
-    for (std::size_t i = 0; i < node_T_.size(); ++i)
-      node_T_[i] = node_capacity_[i] > 0 ? node_T_[i] / node_capacity_[i] : 0.0;
+    // Weights: the sensible capacity C_m. With the latent peak in the weights, the few
+    // particles inside the freezing window would dominate the mean and pull heat across a
+    // sharp front. Any weights conserve energy as long as the mean uses the same ones.
+    capacity_weighted_nodal_temperature(/*with_volume=*/false);
     for (std::size_t p = 0; p < n; ++p) {
       const auto* nodes = st.nodes(p);
       const auto* w = st.weights(p);
       double mean = 0;
       for (int k = 0; k < K; ++k) mean += w[k] * node_T_[nodes[k]];
-      energy_[p] = -gamma * particle_chord_[p] * (T[p] - mean);
+      energy_[p] = -gamma * capacity_[p] * (T[p] - mean);
     }
     for (const auto& r : particles.ranges())
       invert_heat(*sfcc_[r.material], constants_[r.material], phi.subspan(r.begin, r.size()),

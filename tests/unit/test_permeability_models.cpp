@@ -17,9 +17,14 @@
 #include "frostmpm/config/config_node.hpp"
 #include "frostmpm/models/permeability_model.hpp"
 #include "frostmpm/scene/model_section.hpp"
+#include "numerics.hpp"
 #include "test_support.hpp"
 
 namespace {
+
+using frostmpm::test::derivative_matches;
+using frostmpm::test::linspace;
+using frostmpm::test::richardson;
 
 using frostmpm::AbsolutePermeabilityModel;
 using frostmpm::RelativePermeabilityModel;
@@ -91,22 +96,6 @@ const std::map<std::string, std::vector<AbsoluteCase>>& absolute_cases() {
   return cases;
 }
 
-/// Richardson-extrapolated central difference (4 D(h/2) − D(h))/3, error O(h⁴).
-template <class F>
-double richardson(const F& f, double x, double h) {
-  const auto central = [&](double step) { return (f(x + step) - f(x - step)) / (2.0 * step); };
-  return (4.0 * central(0.5 * h) - central(h)) / 3.0;
-}
-
-bool derivative_matches(double analytic, double fd, double tiny_abs) {
-  return std::abs(analytic - fd) <= 1e-6 * std::max(std::abs(analytic), tiny_abs);
-}
-
-std::vector<double> linspace(double a, double b, int n) {
-  std::vector<double> out(n);
-  for (int i = 0; i < n; ++i) out[i] = a + (b - a) * i / (n - 1);
-  return out;
-}
 
 const std::vector<double> kPorosities = {0.2, 0.37, 0.6};
 
