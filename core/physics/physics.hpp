@@ -20,6 +20,14 @@ struct ModelSlot {
   bool required = true;
 };
 
+/// A named array a physics keeps between steps besides particle fields (e.g. a grid field
+/// carried while particles stand still, adaptive-step state, counters). The kernel writes
+/// every one into checkpoints and, on restart, resizes and refills it before the next step.
+struct PersistentArray {
+  std::string name;
+  std::vector<double>* values = nullptr;
+};
+
 /// One stage of the step; the scheduler times each by name for run.json.
 struct Stage {
   std::string name;
@@ -50,6 +58,11 @@ class Physics {
   virtual double stable_time_step() const { return std::numeric_limits<double>::infinity(); }
   /// Called before the stages of a step run, with the step's dt.
   virtual void begin_step(double /*time*/, double /*dt*/) {}
+  /// Everything besides particle fields that the next step depends on; a restart that
+  /// restores these and the particle fields must continue bit for bit.
+  virtual std::vector<PersistentArray> persistent_state() { return {}; }
+  /// Called after a restart has restored the particle fields and persistent_state().
+  virtual void restored() {}
   /// Counters for run.json (e.g. linear iterations); keys are free-form.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
 };

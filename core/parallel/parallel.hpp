@@ -1,0 +1,69 @@
+#pragma once
+// Shared-memory parallel loops (OpenMP, GCC's libgomp) whose results do not depend on the
+// thread count. Loops that only write their own index are trivially reproducible; sums use
+// fixed chunks (independent of the thread count) added in chunk order, so a total is bitwise
+// the same on 1 or N threads. Scatters to grid nodes go through ColouredBlocks.
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace frostmpm {
+
+/// Threads an OpenMP parallel region will use.
+inline int thread_count() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+/// f(i) for i in [0, n), statically split over the threads.
+template <class F>
+void parallel_for(std::size_t n, F&& f) {
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) f(i);
+}
+
+/// Σ f(i) over [0, n), reproducible bitwise whatever the thread count: fixed chunks of 2048
+/// indices are summed in order, then the chunk sums in order.
+template <class F>
+double reproducible_sum(std::size_t n, F&& f) {
+  constexpr std::size_t kChunk = 2048;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<double> partial(chunks, 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::size_t c = 0; c < chunks; ++c) {
+    double s = 0;
+    const std::size_t end = std::min(n, (c + 1) * kChunk);
+    for (std::size_t i = c * kChunk; i < end; ++i) s += f(i);
+    partial[c] = s;
+  }
+  double total = 0;
+  for (double s : partial) total += s;
+  return total;
+}
+
+/// max f(i) over [0, n) (exact in any order), or `empty` when n = 0.
+template <class F>
+double parallel_max(std::size_t n, F&& f, double empty) {
+  double m = empty;
+#pragma omp parallel for schedule(static) reduction(max : m)
+  for (std::size_t i = 0; i < n; ++i) m = std::max(m, f(i));
+  return m;
+}
+
+/// min f(i) over [0, n) (exact in any order), or `empty` when n = 0.
+template <class F>
+double parallel_min(std::size_t n, F&& f, double empty) {
+  double m = empty;
+#pragma omp parallel for schedule(static) reduction(min : m)
+  for (std::size_t i = 0; i < n; ++i) m = std::min(m, f(i));
+  return m;
+}
+
+}  // namespace frostmpm

@@ -1,0 +1,72 @@
+#include "frostmpm/transfer/coloured_blocks.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace frostmpm {
+
+template <int Dim>
+void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache<Dim>& stencil, int width) {
+  if (width < 1) throw std::invalid_argument("ColouredBlocks: width must be positive");
+  const std::size_t n = stencil.particles();
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("ColouredBlocks: more than 2^32 particles");
+  const int K = stencil.per_particle();
+  // Block lattice: node columns -ghost .. cells+ghost, `width` per block.
+  std::array<int, Dim> blocks_along{};
+  for (int d = 0; d < Dim; ++d) blocks_along[d] = (grid.nodes_along(d) + width - 1) / width;
+  std::size_t block_count = 1;
+  for (int d = 0; d < Dim; ++d) block_count *= static_cast<std::size_t>(blocks_along[d]);
+
+  // Block of every particle: from the lowest lattice node of its stencil (every node it
+  // writes lies within `width` columns of it along each axis).
+  std::vector<std::uint32_t> block_of(n);
+  std::vector<std::uint32_t> count(block_count, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    std::array<int, Dim> low{};
+    low.fill(std::numeric_limits<int>::max());
+    const auto* nodes = stencil.nodes(p);
+    for (int k = 0; k < K; ++k) {
+      const auto ijk = grid.node_lattice(nodes[k]);
+      for (int d = 0; d < Dim; ++d) low[d] = std::min(low[d], ijk[d]);
+    }
+    std::size_t index = 0;
+    for (int d = Dim - 1; d >= 0; --d)
+      index = index * static_cast<std::size_t>(blocks_along[d]) +
+              static_cast<std::size_t>((low[d] + grid.ghost_layers) / width);
+    block_of[p] = static_cast<std::uint32_t>(index);
+    ++count[index];
+  }
+  auto colour_of = [&](std::size_t block) {
+    int colour = 0;
+    for (int d = 0; d < Dim; ++d) {
+      colour |= static_cast<int>(block % static_cast<std::size_t>(blocks_along[d]) % 2) << d;
+      block /= static_cast<std::size_t>(blocks_along[d]);
+    }
+    return colour;
+  };
+  // Non-empty blocks, sorted by colour (then by block index, for a fixed order).
+  std::vector<std::uint32_t> used;
+  for (std::size_t b = 0; b < block_count; ++b)
+    if (count[b]) used.push_back(static_cast<std::uint32_t>(b));
+  std::stable_sort(used.begin(), used.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return colour_of(a) < colour_of(b); });
+  std::vector<std::uint32_t> slot(block_count, 0);
+  block_begin_.assign(used.size() + 1, 0);
+  colour_begin_.fill(0);
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    block_begin_[i + 1] = block_begin_[i] + count[used[i]];
+    slot[used[i]] = block_begin_[i];
+    colour_begin_[colour_of(used[i]) + 1] = static_cast<std::uint32_t>(i + 1);
+  }
+  for (int c = 1; c <= kColours; ++c) colour_begin_[c] = std::max(colour_begin_[c], colour_begin_[c - 1]);
+  order_.resize(n);
+  for (std::size_t p = 0; p < n; ++p) order_[slot[block_of[p]]++] = static_cast<std::uint32_t>(p);
+  version_ = stencil.version();
+}
+
+template class ColouredBlocks<2>;
+template class ColouredBlocks<3>;
+
+}  // namespace frostmpm
