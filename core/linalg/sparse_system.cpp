@@ -258,7 +258,7 @@ struct SparseSystem::Impl {
     values_dirty = false;
   }
 
-  void build_preconditioner() {
+  void build_preconditioner(bool refresh) {
     const auto& kind = options.preconditioner;
     if (kind == "jacobi" || kind == "ilu") {
       if (ifpack2.is_null()) {
@@ -291,7 +291,14 @@ struct SparseSystem::Impl {
       params.set("coarse: type", "RELAXATION");
       params.sublist("coarse: params").set("relaxation: type", "Symmetric Gauss-Seidel");
       params.sublist("coarse: params").set("relaxation: sweeps", 4);
-      muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(matrix), params);
+      // A refresh keeps the aggregates and prolongators and recomputes the coarse operators and
+      // smoothers from the new values (MueLu's "RP" reuse).
+      params.set("reuse: type", "RP");
+      if (!muelu.is_null() && refresh) {
+        MueLu::ReuseTpetraPreconditioner(matrix, *muelu);
+      } else {
+        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(matrix), params);
+      }
       problem->setRightPrec(muelu);
     }
     have_preconditioner = true;
@@ -331,7 +338,7 @@ struct SparseSystem::Impl {
     return solver->getNumIters();
   }
 
-  SolveStats solve(std::span<const double> rhs, std::span<double> x_io, bool rebuild) {
+  SolveStats solve(std::span<const double> rhs, std::span<double> x_io, PreconditionerUpdate update) {
     if (rhs.size() != n || x_io.size() != n) {
       throw std::invalid_argument("SparseSystem::solve: rhs and x need " + std::to_string(n) +
                                   " entries (got " + std::to_string(rhs.size()) + " and " +
@@ -346,8 +353,8 @@ struct SparseSystem::Impl {
     const auto setup_start = Clock::now();
     if (values_dirty) upload_values();
     if (options.preconditioner != "none") {
-      if (rebuild || !have_preconditioner) {
-        build_preconditioner();
+      if (update != PreconditionerUpdate::Reuse || !have_preconditioner) {
+        build_preconditioner(have_preconditioner && update == PreconditionerUpdate::Refresh);
       } else {
         stats.preconditioner_reused = true;
       }
@@ -444,7 +451,11 @@ void SparseSystem::add_to_entry(std::size_t row, std::size_t col, double delta) 
 
 SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x,
                                bool rebuild_preconditioner) {
-  return impl_->solve(rhs, x, rebuild_preconditioner);
+  return impl_->solve(rhs, x, rebuild_preconditioner ? PreconditionerUpdate::Rebuild : PreconditionerUpdate::Reuse);
+}
+
+SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update) {
+  return impl_->solve(rhs, x, update);
 }
 
 }  // namespace frostmpm

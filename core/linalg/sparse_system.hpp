@@ -34,6 +34,15 @@ struct SolveStats {
   bool preconditioner_reused = false;  ///< an existing preconditioner was used unchanged
 };
 
+/// What solve() does with the preconditioner of the previous solve.
+enum class PreconditionerUpdate {
+  Reuse,    ///< apply it as it is (cheapest; safe when the values barely changed — a multigrid
+            ///< smoother reads the current matrix, so after large changes CG may break down)
+  Refresh,  ///< recompute it from the current values, keeping what depends only on the graph
+            ///< (Ifpack2: compute(); MueLu: aggregates and prolongators kept, "RP" reuse)
+  Rebuild,  ///< build it from scratch
+};
+
 /// Square sparse system A x = b with a fixed sparsity pattern: CSR, 0-based, global indices
 /// (local = global while the data are serial, see above).
 ///
@@ -80,6 +89,8 @@ class SparseSystem {
   /// that is not positive definite).
   SolveStats solve(std::span<const double> rhs, std::span<double> x,
                    bool rebuild_preconditioner = true);
+  /// The same, with a finer choice of what happens to the preconditioner.
+  SolveStats solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update);
 
  private:
   struct Impl;

@@ -32,23 +32,11 @@ struct PhaseConstants {
     return std::pow(solid_conductivity, 1 - phi) * std::pow(water_conductivity, phi * S) *
            std::pow(ice_conductivity, phi * (1 - S));
   }
-  /// Heat [J/m³] to go from (T0, S0) to (T1, S1): sensible heat with the trapezoidal mean
-  /// capacity plus latent heat of the saturation change.
-  double heat(double phi, double T0, double S0, double T1, double S1) const {
-    return 0.5 * (capacity(phi, S0) + capacity(phi, S1)) * (T1 - T0) + latent_density * phi * (S1 - S0);
-  }
 };
 
 /// Material parameters the thermal physics reads (with the paper's Table 1 defaults).
 ParamSchema material_schema();
 /// Builds the phase constants of a material from its parameters.
 PhaseConstants phase_constants(const ParamSet& material, ConductivityAverage average, bool latent_with_water);
-
-/// Solves heat(T0 → T0 + ΔT) = energy for ΔT on each particle of a range (energy is
-/// monotone in T, so a bracketed Newton iteration always converges). One SFCC batch call per
-/// iteration. `T` is updated in place, `S` receives S_l at the new temperature.
-/// Returns the number of iterations used.
-int invert_heat(const SfccModel& sfcc, const PhaseConstants& pc, std::span<const double> porosity,
-                std::span<const double> energy, std::span<double> T, std::span<double> S);
 
 }  // namespace frostmpm::thermal

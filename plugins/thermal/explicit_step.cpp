@@ -1,0 +1,76 @@
+// Explicit (forward Euler) step on the nodal heat content: e_i += Δt f_i / V_i, then
+// T_i = H_i⁻¹(e_i) — latent heat is absorbed exactly, however narrow the freezing window.
+#include <algorithm>
+
+#include "frostmpm/parallel/parallel.hpp"
+#include "thermal_physics.hpp"
+
+namespace frostmpm::thermal {
+
+/// f_i = −Σ_p V_p κ_p ∇S_ip·∇T_p with ∇T_p = Σ_j T_j ∇S_jp (matrix-free, coloured scatter),
+/// plus the boundary heat flows at time_; returns Σ of the boundary flows [W per m].
+void ThermalPhysics::conduction_force() {
+  const auto& st = sim_->stencil();
+  const auto vol = sim_->particles().field("volume");
+  std::fill(node_force_.begin(), node_force_.end(), 0.0);
+  const int K = st.per_particle();
+  blocks_.for_each([&](std::size_t p) {
+    const auto* nodes = st.nodes(p);
+    const auto* g = st.gradients(p);
+    double grad[kDim] = {};
+    for (int k = 0; k < K; ++k)
+      for (int d = 0; d < kDim; ++d) grad[d] += node_T_[nodes[k]] * g[k * kDim + d];
+    const double a = vol[p] * conductivity_[p];
+    for (int k = 0; k < K; ++k) {
+      double dot = 0;
+      for (int d = 0; d < kDim; ++d) dot += g[k * kDim + d] * grad[d];
+      node_force_[nodes[k]] -= a * dot;
+    }
+  });
+}
+
+double ThermalPhysics::boundary_flow(double time, const std::vector<double>& T, std::vector<double>& into) const {
+  double total = 0;
+  for (const auto& bc : flux_) {
+    const double q = value_at(bc, time);
+    for (std::size_t j = 0; j < bc.nodes.size(); ++j) {
+      if (node_volume_[bc.nodes[j]] <= 0) continue;
+      into[bc.nodes[j]] += q * bc.areas[j];
+      total += q * bc.areas[j];
+    }
+  }
+  for (const auto& bc : convective_) {
+    const double ambient = value_at(bc, time);
+    for (std::size_t j = 0; j < bc.nodes.size(); ++j) {
+      const std::size_t i = bc.nodes[j];
+      if (node_volume_[i] <= 0) continue;
+      const double flow = bc.coefficient * bc.areas[j] * (ambient - T[i]);
+      into[i] += flow;
+      total += flow;
+    }
+  }
+  return total;
+}
+
+void ThermalPhysics::solve_explicit() {
+  conduction_force();
+  const double boundary = boundary_flow(time_, node_T_, node_force_);
+  // Dirichlet nodes are reset to their target; what that takes beyond the heat the node's
+  // neighbours and boundary flows gave it is the boundary's (the reaction).
+  double reaction = 0;
+  for (std::size_t i = 0; i < node_heat_.size(); ++i)
+    if (dirichlet_[i] && node_volume_[i] > 0) {
+      const double target = nodal_.heat(i, dirichlet_target_[i]);
+      reaction += node_volume_[i] * (target - node_heat_[i]) - dt_ * node_force_[i];
+      node_heat_[i] = target;
+      node_T_[i] = dirichlet_target_[i];
+    }
+  boundary_heat_ += dt_ * boundary + reaction;
+  parallel_for(node_heat_.size(), [&](std::size_t i) {
+    if (!is_free(i)) return;
+    node_heat_[i] += dt_ * node_force_[i] / node_volume_[i];
+    node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+  });
+}
+
+}  // namespace frostmpm::thermal
