@@ -63,7 +63,8 @@ class FreezingCurvesTask final : public Task {
     return root;
   }
 
-  void execute(const OutputDir& out) override {
+  void execute(const OutputDir& out, const RunRequest& request) override {
+    if (request.restart) throw InputError("task 'freezing_curves' writes no checkpoints; run it again instead");
     const auto n = static_cast<std::size_t>(range_.integer("samples"));
     const auto& r = range_.reals("temperature_range");
     std::vector<double> T(n), p(n, range_.real("pore_pressure")), phi(n, material_.real("porosity"));

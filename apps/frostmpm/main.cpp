@@ -1,13 +1,17 @@
 // The `frostmpm` command: run, check, plugins, describe.
 #include <chrono>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "frostmpm/config/input_error.hpp"
+#include "frostmpm/io/checkpoint.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
+#include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/simulation.hpp"
 #include "reference.hpp"
 #include "task.hpp"
@@ -23,11 +27,32 @@ struct SceneOptions {
   std::vector<std::string> plugin_paths;
 };
 
-void add_scene_options(CLI::App* cmd, SceneOptions& o) {
-  cmd->add_option("scene", o.scene, "scene file (YAML)")->required();
+void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_required) {
+  cmd->add_option("scene", o.scene, "scene file (YAML)")->required(scene_required);
   cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value")
       ->take_all();
   cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)");
+}
+
+/// The scene as given on the command line, in the form a checkpoint keeps: absolute paths, so
+/// a restart from another folder finds the same plugins.
+SceneSource scene_source(const SceneOptions& o) {
+  SceneSource source;
+  source.text = ConfigNode::read_file(o.scene);
+  source.path = fs::absolute(o.scene).lexically_normal().string();
+  source.overrides = o.overrides;
+  for (const auto& path : o.plugin_paths) source.plugin_paths.push_back(fs::absolute(path).lexically_normal().string());
+  return source;
+}
+
+/// `word` as one shell word (quoted only when it needs to be).
+std::string shell_word(const std::string& word) {
+  if (!word.empty() && word.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_./-+=:,@%") ==
+                           std::string::npos)
+    return word;
+  std::string quoted = "'";
+  for (const char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
 }
 
 /// Everything up to (not including) execution: parse, override, load plugins, validate.
@@ -40,16 +65,17 @@ struct PreparedScene {
   YAML::Node resolved;
 };
 
-std::unique_ptr<PreparedScene> prepare(const SceneOptions& o) {
+/// `scene_name` is what messages call the scene file (the path as the user typed it).
+std::unique_ptr<PreparedScene> prepare(const SceneSource& source, const std::string& scene_name) {
   auto prepared = std::make_unique<PreparedScene>();
-  ConfigNode file_root = ConfigNode::load_file(o.scene);
+  ConfigNode file_root = ConfigNode::load_string(source.text, scene_name);
   YAML::Node tree = file_root.raw();
-  for (const auto& assignment : o.overrides) apply_override(tree, assignment);
-  prepared->root = std::make_unique<ConfigNode>(tree, o.scene);
+  for (const auto& assignment : source.overrides) apply_override(tree, assignment);
+  prepared->root = std::make_unique<ConfigNode>(tree, scene_name);
   const ConfigNode& root = *prepared->root;
 
   prepared->loader = std::make_unique<PluginLoader>(prepared->registry);
-  PluginSetup setup{o.plugin_paths};
+  PluginSetup setup{source.plugin_paths};
   setup.load_defaults(*prepared->loader);
   setup.load_scene_paths(*prepared->loader, root);
   for (const auto& warning : refusal_warnings(*prepared->loader)) std::cerr << "warning: " << warning << "\n";
@@ -100,24 +126,38 @@ nlohmann::json to_json(const YAML::Node& node) {
   }
 }
 
-int cmd_run(const SceneOptions& o, const std::string& out_dir) {
+/// `frostmpm run`: a new run of `o.scene`, or with `restart_dir` the continuation of the run
+/// in that folder from its checkpoint (which holds the scene, overrides and plugin paths).
+int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string& restart_dir,
+            const std::string& program) {
   const auto start = std::chrono::steady_clock::now();
-  auto prepared = prepare(o);
-  const std::string dir = out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
+  const bool restart = !restart_dir.empty();
+  if (restart && (!o.scene.empty() || !out_dir.empty() || !o.overrides.empty() || !o.plugin_paths.empty()))
+    throw InputError("--restart OUT takes no scene, -o, --set or --plugin-path: the checkpoint in OUT holds them");
+  if (!restart && o.scene.empty()) throw InputError("give a scene file to run, or --restart OUT to continue a run");
+  const SceneSource source = restart ? CheckpointReader(restart_dir).scene() : scene_source(o);
+  auto prepared = prepare(source, restart ? source.path : o.scene);
+  const std::string dir =
+      restart ? restart_dir : out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
   OutputDir out(dir);
+  std::optional<RunInterrupted> interrupted;
   try {
-    prepared->task->execute(out);
+    const InterruptGuard stop_cleanly_on_sigint_and_sigterm;
+    prepared->task->execute(out, app::RunRequest{source, restart});
   } catch (const NumericalBlowUp& e) {
     std::cerr << "error: " << e.what() << "; the frames written before it in " << dir
               << " stay readable\n";
     return kBlowUpExitCode;
+  } catch (const RunInterrupted& e) {
+    interrupted = e;
   }
 
   nlohmann::json summary;
   summary["frostmpm_version"] = FROSTMPM_VERSION;
-  summary["scene"] = o.scene;
+  summary["scene"] = restart ? source.path : o.scene;
   summary["task"] = prepared->task_name;
-  summary["overrides"] = o.overrides;
+  summary["status"] = interrupted ? "interrupted" : "finished";
+  summary["overrides"] = source.overrides;
   summary["plugins"] = nlohmann::json::array();
   for (const auto& p : prepared->loader->loaded())
     summary["plugins"].push_back({{"name", p.name}, {"version", p.version}, {"library", p.file}});
@@ -126,12 +166,18 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir) {
   summary["wall_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");
+  if (interrupted) {
+    std::cerr << std::setprecision(10) << "interrupted at t = " << interrupted->time << " s (step "
+              << interrupted->step << "); resume with: " << shell_word(program) << " run --restart "
+              << shell_word(dir) << "\n";
+    return 128 + interrupted->signal;
+  }
   std::cout << "frostmpm: task '" << prepared->task_name << "' finished; results in " << dir << "\n";
   return 0;
 }
 
 int cmd_check(const SceneOptions& o) {
-  auto prepared = prepare(o);
+  auto prepared = prepare(scene_source(o), o.scene);
   YAML::Emitter emitter;
   emitter << prepared->resolved;
   std::cout << "# " << o.scene << ": valid. Resolved scene with defaults:\n" << emitter.c_str() << "\n";
@@ -146,13 +192,17 @@ int main(int argc, char** argv) {
   cli.set_version_flag("--version", FROSTMPM_VERSION);
 
   SceneOptions run_options, check_options;
-  std::string out_dir;
-  auto* run = cli.add_subcommand("run", "run a scene");
-  add_scene_options(run, run_options);
+  std::string out_dir, restart_dir;
+  auto* run = cli.add_subcommand("run", "run a scene, or continue a stopped run with --restart OUT");
+  add_scene_options(run, run_options, /*scene_required=*/false);  // not with --restart
   run->add_option("-o,--output", out_dir, "output folder (default: frostmpm-out/<scene name>)");
+  run->add_option("--restart", restart_dir,
+                  "continue the run in folder OUT from OUT/checkpoint.h5, appending to its outputs "
+                  "(give nothing else: the checkpoint holds the scene, overrides and plugin paths)")
+      ->type_name("OUT");
 
   auto* check = cli.add_subcommand("check", "validate a scene and print it with defaults filled in");
-  add_scene_options(check, check_options);
+  add_scene_options(check, check_options, /*scene_required=*/true);
 
   std::vector<std::string> list_paths;
   auto* plugins = cli.add_subcommand("plugins", "list every registered model by kind, with library and version");
@@ -175,7 +225,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kInputErrorExitCode;
   }
   try {
-    if (*run) return cmd_run(run_options, out_dir);
+    if (*run) return cmd_run(run_options, out_dir, restart_dir, argv[0]);
     if (*check) return cmd_check(check_options);
     if (*plugins) return app::cmd_plugins(list_paths, std::cout);
     if (*describe) return app::cmd_describe(describe_target, markdown, describe_paths, std::cout);

@@ -15,9 +15,12 @@ class SimulationTask final : public Task {
 
   std::vector<std::string> sections() const override { return Simulation::sections(); }
   YAML::Node resolved() const override { return sim_.resolved(); }
-  void execute(const OutputDir& out) override {
-    const bool progress = sim_.resolved()["output"]["progress"].as<bool>();
-    sim_.run(out, progress);
+  void execute(const OutputDir& out, const RunRequest& request) override {
+    RunOptions options;
+    options.progress = sim_.resolved()["output"]["progress"].as<bool>();
+    options.restart = request.restart;
+    options.scene = request.scene;
+    sim_.run(out, options);
     // Counters named *unconverged* flag steps whose iteration hit its cap; say so, not just
     // in run.json.
     for (const auto& physics : sim_.physics())
@@ -31,6 +34,7 @@ class SimulationTask final : public Task {
     YAML::Node s;
     const auto& st = sim_.statistics();
     s["steps"] = st.steps;
+    s["restarts"] = sim_.restarts();
     s["simulated_seconds"] = sim_.time();
     s["dt"]["min"] = st.dt_min;
     s["dt"]["max"] = st.dt_max;

@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "frostmpm/config/config_node.hpp"
+#include "frostmpm/io/checkpoint.hpp"
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/plugin/plugin_loader.hpp"
 
@@ -21,6 +22,12 @@ struct TaskContext {
   const ConfigNode& root;  ///< scene root; a task consumes the sections it owns
 };
 
+/// How `frostmpm run` starts a task.
+struct RunRequest {
+  SceneSource scene;     ///< what a checkpoint must keep to re-create the scene
+  bool restart = false;  ///< continue from OUT/checkpoint.h5
+};
+
 class Task {
  public:
   virtual ~Task() = default;
@@ -28,7 +35,7 @@ class Task {
   virtual std::vector<std::string> sections() const = 0;
   /// The scene as it will run: every section with defaults filled in.
   virtual YAML::Node resolved() const = 0;
-  virtual void execute(const OutputDir& out) = 0;
+  virtual void execute(const OutputDir& out, const RunRequest& request) = 0;
   /// Task-specific facts for run.json (steps, timings, counters).
   virtual YAML::Node summary() const { return {}; }
 };

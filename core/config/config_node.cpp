@@ -14,7 +14,9 @@ ConfigNode::ConfigNode(YAML::Node node, std::string file, std::string path)
       path_(std::move(path)),
       consumed_(std::make_shared<std::set<std::string>>()) {}
 
-ConfigNode ConfigNode::load_file(const std::string& file) {
+ConfigNode ConfigNode::load_file(const std::string& file) { return load_string(read_file(file), file); }
+
+std::string ConfigNode::read_file(const std::string& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec))
     throw InputError(file + ": scene file does not exist");
@@ -24,7 +26,7 @@ ConfigNode ConfigNode::load_file(const std::string& file) {
   if (!in) throw InputError(file + ": cannot be read");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return load_string(buffer.str(), file);
+  return buffer.str();
 }
 
 ConfigNode ConfigNode::load_string(const std::string& text, const std::string& name) {

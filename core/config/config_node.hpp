@@ -19,6 +19,8 @@ class ConfigNode {
 
   /// Parses a scene file; a missing file or malformed YAML is an InputError.
   static ConfigNode load_file(const std::string& file);
+  /// The text of a scene file; an InputError when it is missing or cannot be read.
+  static std::string read_file(const std::string& file);
   static ConfigNode load_string(const std::string& text, const std::string& name = "<string>");
 
   const std::string& path() const { return path_; }

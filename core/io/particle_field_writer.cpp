@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -15,94 +16,14 @@
 #include <system_error>
 #include <utility>
 
+#include "frostmpm/io/hdf5_support.hpp"
+
 namespace frostmpm {
 
 namespace {
 
 constexpr const char* kH5Name = "fields.h5";
 constexpr const char* kXdmfName = "fields.xdmf";
-
-// ---- HDF5 error handling -------------------------------------------------------------------
-
-/// While alive, HDF5 does not print its error stack to stderr; failures are reported through
-/// the exceptions below instead (with the stack's most specific messages).
-class QuietHdf5Errors {
- public:
-  QuietHdf5Errors() {
-    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
-  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
-  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
-
- private:
-  H5E_auto2_t func_ = nullptr;
-  void* data_ = nullptr;
-};
-
-herr_t collect_error(unsigned, const H5E_error2_t* err, void* out) {
-  auto& messages = *static_cast<std::vector<std::string>*>(out);
-  if (err && err->desc && *err->desc) messages.emplace_back(err->desc);
-  return 0;
-}
-
-/// The current HDF5 error stack, most specific message first (at most three), then clears it.
-std::string hdf5_error_text() {
-  std::vector<std::string> messages;
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_error, &messages);
-  H5Eclear2(H5E_DEFAULT);
-  std::string text;
-  for (std::size_t i = 0; i < messages.size() && i < 3; ++i) text += (i ? "; " : "") + messages[i];
-  return text.empty() ? std::string("unknown HDF5 error") : text;
-}
-
-[[noreturn]] void hdf5_fail(const std::string& what) {
-  throw std::runtime_error("ParticleFieldWriter: " + what + " failed: " + hdf5_error_text());
-}
-
-void check(herr_t status, const std::string& what) {
-  if (status < 0) hdf5_fail(what);
-}
-
-/// Owns an HDF5 identifier.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle(hid_t id, Closer closer, const std::string& what) : id_(id), closer_(closer) {
-    if (id_ < 0) hdf5_fail(what);
-  }
-  ~Handle() {
-    if (id_ >= 0) closer_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  Closer closer_;
-};
-
-template <class T>
-void write_scalar_attribute(hid_t object, const char* name, hid_t type, T value) {
-  const Handle space(H5Screate(H5S_SCALAR), H5Sclose, "H5Screate");
-  const Handle attr(H5Acreate2(object, name, type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
-                    std::string("creating attribute ") + name);
-  check(H5Awrite(attr.get(), type, &value), std::string("writing attribute ") + name);
-}
-
-/// Creates dataset `name` in `group` with the given shape and writes `data` (may be null when
-/// the dataset is empty).
-void write_dataset(hid_t group, const std::string& name, hid_t file_type, hid_t mem_type,
-                   const std::vector<hsize_t>& dims, const void* data, int components_attribute) {
-  const Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
-                     "H5Screate_simple for " + name);
-  const Handle dset(H5Dcreate2(group, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                    H5Dclose, "creating dataset " + name);
-  if (dims.front() > 0) check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "writing " + name);
-  if (components_attribute > 0) write_scalar_attribute(dset.get(), "components", H5T_NATIVE_INT, components_attribute);
-}
 
 // ---- validation ----------------------------------------------------------------------------
 
@@ -160,6 +81,58 @@ std::string data_item(std::size_t count, int columns, const char* number_type, i
          "</DataItem>";
 }
 
+/// What fields.xdmf says about one stored frame.
+struct FrameLayout {
+  std::string group;
+  double time = 0;
+  std::size_t count = 0;
+  bool wide_ids = false;  ///< connectivity stored as int64
+  std::vector<std::pair<std::string, int>> fields;  ///< name, components
+};
+
+/// The XDMF <Grid> element of one frame.
+std::string xdmf_grid(const FrameLayout& f) {
+  const std::string path = "/" + f.group;
+  std::string grid;
+  grid += "      <Grid Name=\"" + f.group + "\" GridType=\"Uniform\">\n";
+  grid += "        <Time Value=\"" + number_text(f.time) + "\"/>\n";
+  grid += "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" + std::to_string(f.count) +
+          "\" NodesPerElement=\"1\">\n          " +
+          data_item(f.count, 1, "Int", f.wide_ids ? 8 : 4, path + "/connectivity") + "\n        </Topology>\n";
+  grid += "        <Geometry GeometryType=\"XYZ\">\n          " +
+          data_item(f.count, 3, "Float", 8, path + "/coordinates") + "\n        </Geometry>\n";
+  for (const auto& [name, components] : f.fields) {
+    const auto [type, columns] = attribute_layout(components);
+    grid += "        <Attribute Name=\"" + name + "\" AttributeType=\"" + type + "\" Center=\"Node\">\n          " +
+            data_item(f.count, columns, "Float", 8, path + "/" + name) + "\n        </Attribute>\n";
+  }
+  grid += "      </Grid>\n";
+  return grid;
+}
+
+/// Reads back the layout of a frame group written by ParticleFieldWriter (fields in name order).
+FrameLayout read_layout(hdf5::Id file, const std::string& group_name) {
+  const hdf5::Handle group = hdf5::open_group(file, group_name);
+  FrameLayout f;
+  f.group = group_name;
+  f.time = hdf5::read_real_attribute(group.get(), "time");
+  f.count = static_cast<std::size_t>(hdf5::read_integer_attribute(group.get(), "count"));
+  f.wide_ids = hdf5::dataset_element_size(group.get(), "connectivity") == 8;
+  hdf5::dataset_shape(group.get(), "coordinates");  // present, or the frame is not complete
+  for (const auto& name : hdf5::child_names(group.get())) {
+    if (name == "coordinates" || name == "connectivity") continue;
+    const auto shape = hdf5::dataset_shape(group.get(), name);
+    const int stored = shape.size() == 2 ? static_cast<int>(shape[1]) : 1;
+    f.fields.emplace_back(name, hdf5::dataset_components(group.get(), name, stored));
+  }
+  return f;
+}
+
+void check_dim(int dim) {
+  if (dim != 2 && dim != 3)
+    throw std::invalid_argument("ParticleFieldWriter: dim must be 2 or 3, got " + std::to_string(dim));
+}
+
 }  // namespace
 
 // ---- writer --------------------------------------------------------------------------------
@@ -167,21 +140,23 @@ std::string data_item(std::size_t count, int columns, const char* number_type, i
 struct ParticleFieldWriter::Impl {
   std::string dir;
   int dim = 3;
-  hid_t file = H5I_INVALID_HID;
+  hdf5::Handle file;
   std::string xdmf_grids;  ///< the <Grid> elements of every complete frame, in order
   std::size_t frames = 0;
   std::set<long> steps;
+
+  Impl(const std::string& folder, int dimension) : dir(folder.empty() ? std::string(".") : folder), dim(dimension) {}
 
   std::string h5_path() const { return dir + "/" + kH5Name; }
   std::string xdmf_path() const { return dir + "/" + kXdmfName; }
 
   ~Impl() {
-    if (file >= 0) {
-      const QuietHdf5Errors quiet;
-      H5Fclose(file);
-      H5Eclear2(H5E_DEFAULT);
-    }
+    const hdf5::QuietErrors quiet;
+    file = hdf5::Handle();
+    H5Eclear2(H5E_DEFAULT);
   }
+
+  void flush() const { hdf5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flushing " + h5_path()); }
 
   void write_xdmf() const {
     const std::string final_path = xdmf_path();
@@ -207,91 +182,104 @@ struct ParticleFieldWriter::Impl {
     }
   }
 
-  /// Writes the frame's group; returns its XDMF <Grid> element.
-  std::string write_group(const std::string& group_name, double time, long step, std::size_t count,
-                          const double* positions, const std::vector<FieldView>& fields) const {
-    const std::string path = "/" + group_name;
-    const Handle group(H5Gcreate2(file, group_name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                       "creating group " + group_name);
-    write_scalar_attribute(group.get(), "time", H5T_NATIVE_DOUBLE, time);
-    write_scalar_attribute(group.get(), "step", H5T_NATIVE_INT64, static_cast<std::int64_t>(step));
-    write_scalar_attribute(group.get(), "count", H5T_NATIVE_INT64, static_cast<std::int64_t>(count));
+  void add_to_xdmf(const FrameLayout& layout, long step) {
+    steps.insert(step);
+    xdmf_grids += xdmf_grid(layout);
+    ++frames;
+  }
 
-    const hsize_t n = count;
-    std::string grid;
-    grid += "      <Grid Name=\"" + group_name + "\" GridType=\"Uniform\">\n";
-    grid += "        <Time Value=\"" + number_text(time) + "\"/>\n";
+  /// Writes the frame's group; returns its layout.
+  FrameLayout write_group(const std::string& group_name, double time, long step, std::size_t count,
+                          const double* positions, const std::vector<FieldView>& fields) const {
+    const hdf5::Handle group = hdf5::create_group(file.get(), group_name);
+    hdf5::write_attribute(group.get(), "time", time);
+    hdf5::write_attribute(group.get(), "step", static_cast<std::int64_t>(step));
+    hdf5::write_attribute(group.get(), "count", static_cast<std::int64_t>(count));
+    FrameLayout layout{group_name, time, count, false, {}};
 
     // Polyvertex cells: ParaView's Xdmf3 reader builds cells only from an explicit connectivity.
-    const bool wide = count > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
-    if (wide) {
+    layout.wide_ids = count > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+    if (layout.wide_ids) {
       std::vector<std::int64_t> ids(count);
       std::iota(ids.begin(), ids.end(), std::int64_t{0});
-      write_dataset(group.get(), "connectivity", H5T_STD_I64LE, H5T_NATIVE_INT64, {n}, ids.data(), 0);
+      hdf5::write_dataset(group.get(), "connectivity", H5T_STD_I64LE, H5T_NATIVE_INT64, {count}, ids.data());
     } else {
       std::vector<std::int32_t> ids(count);
       std::iota(ids.begin(), ids.end(), std::int32_t{0});
-      write_dataset(group.get(), "connectivity", H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, ids.data(), 0);
+      hdf5::write_dataset(group.get(), "connectivity", H5T_STD_I32LE, H5T_NATIVE_INT32, {count}, ids.data());
     }
-    grid += "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" + std::to_string(count) +
-            "\" NodesPerElement=\"1\">\n          " + data_item(count, 1, "Int", wide ? 8 : 4, path + "/connectivity") +
-            "\n        </Topology>\n";
 
     // Geometry: always XYZ (z = 0 in 2D), the form every ParaView reader handles.
     std::vector<double> xyz(count * 3, 0.0);
     for (std::size_t p = 0; p < count; ++p)
       for (int c = 0; c < dim; ++c) xyz[3 * p + c] = positions[dim * p + c];
-    write_dataset(group.get(), "coordinates", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n, 3}, xyz.data(), dim);
-    grid += "        <Geometry GeometryType=\"XYZ\">\n          " +
-            data_item(count, 3, "Float", 8, path + "/coordinates") + "\n        </Geometry>\n";
+    hdf5::write_dataset(group.get(), "coordinates", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {count, 3}, xyz.data(), dim);
 
     for (const auto& field : fields) {
-      const auto [type, columns] = attribute_layout(field.components);
-      if (columns == 1) {
-        write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n}, field.data, 1);
-      } else if (columns != field.components) {  // padded 2-vector
-        std::vector<double> padded(count * columns, 0.0);
+      const int columns = attribute_layout(field.components).second;
+      const double* data = field.data;
+      std::vector<double> padded;
+      if (columns != field.components) {  // 2-vector stored as 3
+        padded.assign(count * columns, 0.0);
         for (std::size_t p = 0; p < count; ++p)
-          for (int c = 0; c < field.components; ++c)
-            padded[columns * p + c] = field.data[field.components * p + c];
-        write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                      {n, static_cast<hsize_t>(columns)}, padded.data(), field.components);
-      } else {
-        write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                      {n, static_cast<hsize_t>(columns)}, field.data, field.components);
+          for (int c = 0; c < field.components; ++c) padded[columns * p + c] = field.data[field.components * p + c];
+        data = padded.data();
       }
-      grid += "        <Attribute Name=\"" + field.name + "\" AttributeType=\"" + type + "\" Center=\"Node\">\n          " +
-              data_item(count, columns, "Float", 8, path + "/" + field.name) + "\n        </Attribute>\n";
+      const std::vector<std::size_t> dims =
+          columns == 1 ? std::vector<std::size_t>{count} : std::vector<std::size_t>{count, std::size_t(columns)};
+      hdf5::write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, field.components);
+      layout.fields.emplace_back(field.name, field.components);
     }
-    grid += "      </Grid>\n";
-    return grid;
+    return layout;
   }
 };
 
-ParticleFieldWriter::ParticleFieldWriter(const std::string& dir, int dim) : impl_(std::make_unique<Impl>()) {
-  if (dim != 2 && dim != 3)
-    throw std::invalid_argument("ParticleFieldWriter: dim must be 2 or 3, got " + std::to_string(dim));
-  impl_->dir = dir.empty() ? std::string(".") : dir;
-  impl_->dim = dim;
+ParticleFieldWriter::ParticleFieldWriter(const std::string& dir, int dim) {
+  check_dim(dim);
+  impl_ = std::make_unique<Impl>(dir, dim);
   std::error_code ec;
   std::filesystem::create_directories(impl_->dir, ec);
   if (ec) throw std::runtime_error("ParticleFieldWriter: cannot create folder " + impl_->dir + ": " + ec.message());
 
-  const QuietHdf5Errors quiet;
-  const Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "H5Pcreate");
-  // Readers (ParaView, scripts/read_fields.py) may open the file while the run is going on; with
-  // HDF5's default file locking they would be refused until the writer closes it.
-#if H5_VERSION_GE(1, 10, 7)
-  check(H5Pset_file_locking(fapl.get(), 0, 1), "H5Pset_file_locking");
-#endif
-  // The default (earliest) file format is kept on purpose: newer superblocks mark a file "open
-  // for writing" and readers refuse it after a crash until h5clear is run.
-  impl_->file = H5Fcreate(impl_->h5_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
-  if (impl_->file < 0) hdf5_fail("creating " + impl_->h5_path());
-  write_scalar_attribute(impl_->file, "dim", H5T_NATIVE_INT, dim);
-  check(H5Fflush(impl_->file, H5F_SCOPE_GLOBAL), "flushing " + impl_->h5_path());
+  const hdf5::QuietErrors quiet;
+  // Readers (ParaView, scripts/read_fields.py) may open the file while the run is going on, so
+  // it is created without HDF5 file locking.
+  impl_->file = hdf5::create_file(impl_->h5_path());
+  hdf5::write_attribute(impl_->file.get(), "dim", dim);
+  impl_->flush();
   // Replace any fields.xdmf of an earlier run at once: it would point into the truncated file.
   impl_->write_xdmf();
+}
+
+ParticleFieldWriter::ParticleFieldWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim, std::size_t keep_frames) {
+  check_dim(dim);
+  auto impl = std::make_unique<Impl>(dir, dim);
+  const hdf5::QuietErrors quiet;
+  impl->file = hdf5::open_file(impl->h5_path(), /*writable=*/true);
+  const hdf5::Id file = impl->file.get();
+  const auto stored_dim = hdf5::read_integer_attribute(file, "dim");
+  if (stored_dim != dim)
+    throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored_dim) +
+                             "-D frames, not " + std::to_string(dim) + "-D");
+  // Frames in step order (group names sort by step only up to six digits).
+  std::vector<std::pair<long, std::string>> stored;
+  for (const auto& name : hdf5::child_names(file)) {
+    if (name.rfind("step_", 0) != 0) continue;
+    const hdf5::Handle group = hdf5::open_group(file, name);
+    stored.emplace_back(static_cast<long>(hdf5::read_integer_attribute(group.get(), "step")), name);
+  }
+  std::sort(stored.begin(), stored.end());
+  if (stored.size() < keep_frames)
+    throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored.size()) +
+                             " frames, fewer than the " + std::to_string(keep_frames) + " to keep");
+  for (std::size_t i = keep_frames; i < stored.size(); ++i)
+    hdf5::check(H5Ldelete(file, stored[i].second.c_str(), H5P_DEFAULT), "deleting " + stored[i].second);
+  for (std::size_t i = 0; i < keep_frames; ++i) impl->add_to_xdmf(read_layout(file, stored[i].second), stored[i].first);
+  impl->flush();
+  impl->write_xdmf();
+  return ParticleFieldWriter(std::move(impl));
 }
 
 ParticleFieldWriter::~ParticleFieldWriter() = default;
@@ -330,20 +318,19 @@ void ParticleFieldWriter::write(double time, long step, std::size_t count, const
   std::snprintf(name_buffer, sizeof name_buffer, "step_%06ld", step);
   const std::string group_name = name_buffer;
 
-  const QuietHdf5Errors quiet;
-  std::string grid;
+  const hdf5::QuietErrors quiet;
+  FrameLayout layout;
   try {
-    grid = m.write_group(group_name, time, step, count, positions, fields);
+    layout = m.write_group(group_name, time, step, count, positions, fields);
   } catch (...) {
     // Drop the half-written group (best effort); the XDMF never referenced it.
-    if (H5Lexists(m.file, group_name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(m.file, group_name.c_str(), H5P_DEFAULT);
+    if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0)
+      H5Ldelete(m.file.get(), group_name.c_str(), H5P_DEFAULT);
     H5Eclear2(H5E_DEFAULT);
     throw;
   }
-  check(H5Fflush(m.file, H5F_SCOPE_GLOBAL), "flushing " + m.h5_path());
-  m.steps.insert(step);
-  m.xdmf_grids += grid;
-  ++m.frames;
+  m.flush();
+  m.add_to_xdmf(layout, step);
   m.write_xdmf();
 }
 

@@ -12,6 +12,10 @@
 //                                every field dataset has attribute components = c as given
 //   root attribute dim (int).
 //
+// Restart: reopen() keeps the first frames of an existing fields.h5 (those a checkpoint knows
+// about), deletes later ones and rebuilds fields.xdmf from the frames present, listing each
+// frame's fields in name order; new frames are appended after them.
+//
 // Crash safety: after every frame the HDF5 file is flushed and fields.xdmf is rewritten
 // atomically (fields.xdmf.partial, then rename), so the XDMF only ever lists complete frames and
 // a run that dies later leaves every earlier frame readable. The HDF5 file is written without
@@ -38,6 +42,11 @@ class ParticleFieldWriter {
   /// needed). dim = 2 or 3, else std::invalid_argument; std::runtime_error if the files cannot
   /// be created.
   ParticleFieldWriter(const std::string& dir, int dim);
+  /// Opens <dir>/fields.h5 written by an earlier writer for appending: keeps its first
+  /// `keep_frames` frames in step order, deletes the rest (their space is not reclaimed) and
+  /// rewrites fields.xdmf. std::runtime_error if the file cannot be opened, holds frames of
+  /// another dimension, or fewer than `keep_frames` frames.
+  static ParticleFieldWriter reopen(const std::string& dir, int dim, std::size_t keep_frames);
   ~ParticleFieldWriter();
   ParticleFieldWriter(const ParticleFieldWriter&) = delete;
   ParticleFieldWriter& operator=(const ParticleFieldWriter&) = delete;
@@ -52,7 +61,7 @@ class ParticleFieldWriter {
   void write(double time, long step, std::size_t count, const double* positions,
              const std::vector<FieldView>& fields);
 
-  /// Number of frames written so far.
+  /// Number of frames written so far (kept frames included after reopen()).
   std::size_t frames() const;
 
   std::string h5_path() const;    ///< <dir>/fields.h5
@@ -61,6 +70,7 @@ class ParticleFieldWriter {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  explicit ParticleFieldWriter(std::unique_ptr<Impl> impl);
 };
 
 }  // namespace frostmpm

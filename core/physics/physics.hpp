@@ -52,16 +52,23 @@ class Physics {
   virtual std::vector<Stage> stages() = 0;
 
   /// Called once before the first output, after initial values are set: bring derived
-  /// fields (e.g. saturation from temperature) in line with the initial state.
+  /// fields (e.g. saturation from temperature) in line with the initial state. A restart
+  /// calls it the same way, on the scene's initial state, before the checkpoint overwrites
+  /// every particle field and persistent array.
   virtual void initialize() {}
   /// Largest stable time step for the current state (infinity when unconditionally stable).
   virtual double stable_time_step() const { return std::numeric_limits<double>::infinity(); }
   /// Called before the stages of a step run, with the step's dt.
   virtual void begin_step(double /*time*/, double /*dt*/) {}
   /// Everything besides particle fields that the next step depends on; a restart that
-  /// restores these and the particle fields must continue bit for bit.
+  /// restores these and the particle fields must continue bit for bit. Any number of arrays
+  /// of any length (0 too); a restart resizes each to its stored length. The names must stay
+  /// the same for a checkpoint to be restored.
   virtual std::vector<PersistentArray> persistent_state() { return {}; }
-  /// Called after a restart has restored the particle fields and persistent_state().
+  /// Called after a restart has restored the particle fields and persistent_state(): rebuild
+  /// or invalidate whatever initialize() derived from the initial state. The first step after
+  /// a restart takes its size from the checkpoint, so stable_time_step() is next asked after
+  /// that step, exactly as in the uninterrupted run.
   virtual void restored() {}
   /// Counters for run.json (e.g. linear iterations); keys are free-form.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }

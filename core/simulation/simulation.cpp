@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -11,6 +12,7 @@
 
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
+#include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/scene/region.hpp"
 
 namespace frostmpm {
@@ -44,7 +46,7 @@ struct Simulation::RegionInit {
 };
 
 std::vector<std::string> Simulation::sections() {
-  return {"grid", "time", "physics", "materials", "regions", "boundary_conditions", "output", "probes"};
+  return {"grid", "time", "physics", "materials", "regions", "boundary_conditions", "output", "probes", "checkpoint"};
 }
 
 Simulation::Simulation(const Registry& registry, const ConfigNode& root) : registry_(registry) {
@@ -64,9 +66,17 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   read_output(root.child("output"));
   const auto probes = root.optional_child("probes");
   read_probes(probes ? &*probes : nullptr);
+  const auto checkpoint = root.optional_child("checkpoint");
+  read_checkpoint(checkpoint ? *checkpoint : ConfigNode(YAML::Node(YAML::NodeType::Map), root.file(), "checkpoint"));
 }
 
 Simulation::~Simulation() = default;
+
+RunInterrupted::RunInterrupted(int signal_number, double at_time, long at_step)
+    : std::runtime_error("interrupted by signal " + std::to_string(signal_number)),
+      signal(signal_number),
+      time(at_time),
+      step(at_step) {}
 
 void Simulation::read_grid(const ConfigNode& node) {
   ParamSchema s;
@@ -378,6 +388,16 @@ void Simulation::read_probes(const ConfigNode* node) {
   resolved_["probes"] = resolved;
 }
 
+void Simulation::read_checkpoint(const ConfigNode& node) {
+  ParamSchema s;
+  s.integer("every_steps", "steps between checkpoints (OUT/checkpoint.h5); 0 = off").defaults_to(0L).at_least(0);
+  s.real("every_minutes", "min", "wall-clock minutes between checkpoints; 0 = off").defaults_to(30.0).at_least(0);
+  const ParamSet p = parse_params(s, node);
+  checkpoint_every_steps_ = p.integer("every_steps");
+  checkpoint_every_minutes_ = p.real("every_minutes");
+  resolved_["checkpoint"] = p.to_yaml();
+}
+
 // ------------------------------------------------------------------------------------------
 
 void Simulation::advance(double dt) {
@@ -508,12 +528,125 @@ std::vector<double> Simulation::evaluate_probes() const {
   return out;
 }
 
-void Simulation::run(const OutputDir& out, bool progress) {
-  ParticleFieldWriter writer(out.path(), kDim);
-  std::ofstream metrics(out.file("metrics.csv"));
-  metrics << "time_s,step,dt_s";
-  for (const auto& probe : probes_) metrics << ',' << probe->name;
-  metrics << '\n' << std::setprecision(12);
+std::string Simulation::metrics_header() const {
+  std::string header = "time_s,step,dt_s";
+  for (const auto& probe : probes_) header += ',' + probe->name;
+  return header;
+}
+
+double Simulation::plan_step(const LoopState& loop) const {
+  const double eps = 1e-9 * end_time_;
+  double dt = fixed_dt_ > 0 ? fixed_dt_ : std::numeric_limits<double>::infinity();
+  for (const auto& physics : physics_) dt = std::min(dt, physics->stable_time_step());
+  if (max_dt_ > 0) dt = std::min(dt, max_dt_);
+  if (!std::isfinite(dt)) dt = end_time_ - time_;
+  // Land exactly on output, metrics and end times without leaving a sliver step: when the
+  // target is less than two steps away, split the remaining gap in two.
+  for (double target : {loop.next_output, metrics_every_ > 0 ? std::min(loop.next_metrics, end_time_) : end_time_,
+                        end_time_}) {
+    const double gap = target - time_;
+    if (gap <= eps) continue;
+    if (dt >= gap - eps) dt = gap;
+    else if (2 * dt > gap) dt = 0.5 * gap;
+  }
+  return dt;
+}
+
+void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene) {
+  const auto start = Clock::now();
+  loop.time = time_;
+  loop.step = step_;
+  loop.dt = dt_;
+  loop.statistics = stats_;
+  loop.restarts = restarts_;
+  CheckpointWriter checkpoint(dir);
+  checkpoint.write(scene);
+  checkpoint.write(loop);
+  checkpoint.write(particles_);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    checkpoint.write_physics(physics_keys_[i], physics_[i]->persistent_state());
+  checkpoint.commit();
+  stats_.stage_seconds["kernel.checkpoint"] += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+LoopState Simulation::restore_checkpoint(const std::string& dir) {
+  const CheckpointReader checkpoint(dir);
+  checkpoint.read(particles_);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    checkpoint.read_physics(physics_keys_[i], physics_[i]->persistent_state());
+  LoopState loop = checkpoint.loop();
+  time_ = loop.time;
+  step_ = loop.step;
+  dt_ = loop.dt;
+  stats_ = loop.statistics;
+  restarts_ = loop.restarts + 1;
+  for (auto& physics : physics_) physics->restored();
+  return loop;
+}
+
+namespace {
+
+/// fields.h5 of the run being restarted, cut back to the frames its checkpoint knows.
+ParticleFieldWriter reopen_fields(const OutputDir& out, long frames) {
+  if (!std::filesystem::exists(out.file("fields.h5"))) {
+    std::cerr << "warning: " << out.file("fields.h5") << " is missing; a new one holds the frames after the "
+              << "checkpoint\n";
+    return ParticleFieldWriter(out.path(), kDim);
+  }
+  try {
+    return ParticleFieldWriter::reopen(out.path(), kDim, static_cast<std::size_t>(frames));
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string(e.what()) + "; move fields.h5 away to continue without the earlier frames");
+  }
+}
+
+/// metrics.csv of the run being restarted, cut back to the rows its checkpoint knows (rewritten
+/// atomically), open for appending.
+std::ofstream reopen_metrics(const OutputDir& out, const std::string& header, long rows) {
+  const std::string path = out.file("metrics.csv");
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line) || line != header)
+    throw InputError(path + ": missing, or its header is not the scene's '" + header + "'");
+  std::string kept = header + "\n";
+  long found = 0;
+  // Only complete lines count: a kill can leave the last one cut short.
+  while (found < rows && std::getline(in, line) && !in.eof()) {
+    kept += line + "\n";
+    ++found;
+  }
+  if (found < rows)
+    throw InputError(path + ": holds " + std::to_string(found) + " complete rows, the checkpoint expects " +
+                     std::to_string(rows));
+  in.close();
+  out.write_text("metrics.csv", kept);
+  return std::ofstream(path, std::ios::app);
+}
+
+}  // namespace
+
+void Simulation::run(const OutputDir& out, const RunOptions& options) {
+  // The stencil is needed by the first probe evaluation.
+  stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  // On a restart too: whatever a physics derives from the initial state is set up as in a new
+  // run, and the checkpoint then overwrites every field and persistent array.
+  for (auto& physics : physics_) physics->initialize();
+  LoopState loop;
+  if (options.restart) {
+    loop = restore_checkpoint(out.path());
+  } else {
+    remove_checkpoint(out.path());  // an earlier run's checkpoint would not match these outputs
+    loop.next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;
+    loop.next_metrics = metrics_every_ > 0 ? metrics_every_ : 0;
+  }
+  const std::string header = metrics_header();
+  ParticleFieldWriter writer =
+      options.restart ? reopen_fields(out, loop.frames) : ParticleFieldWriter(out.path(), kDim);
+  std::ofstream metrics = options.restart ? reopen_metrics(out, header, loop.metrics_rows)
+                                          : std::ofstream(out.file("metrics.csv"));
+  if (!options.restart) metrics << header << '\n';
+  metrics << std::setprecision(12);
+  loop.frames = static_cast<long>(writer.frames());
 
   auto write_frame = [&] {
     std::vector<FieldView> views;
@@ -528,49 +661,62 @@ void Simulation::run(const OutputDir& out, bool progress) {
     metrics.flush();
   };
 
-  // The stencil is needed by the first probe evaluation.
-  stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
-  for (auto& physics : physics_) physics->initialize();
-  write_frame();
-  write_metrics();
   const double eps = 1e-9 * end_time_;
-  double next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;
-  double next_metrics = metrics_every_ > 0 ? metrics_every_ : 0;
+  if (!options.restart) {
+    write_frame();
+    write_metrics();
+    ++loop.frames;
+    ++loop.metrics_rows;
+    if (time_ < end_time_ - eps) loop.next_dt = plan_step(loop);
+  }
   const auto wall_start = Clock::now();
-  auto last_print = wall_start;
+  const double time_start = time_;
+  auto last_print = wall_start, last_checkpoint = wall_start;
   while (time_ < end_time_ - eps) {
-    double dt = fixed_dt_ > 0 ? fixed_dt_ : std::numeric_limits<double>::infinity();
-    for (const auto& physics : physics_) dt = std::min(dt, physics->stable_time_step());
-    if (max_dt_ > 0) dt = std::min(dt, max_dt_);
-    if (!std::isfinite(dt)) dt = end_time_ - time_;
-    // Land exactly on output, metrics and end times without leaving a sliver step: when the
-    // target is less than two steps away, split the remaining gap in two.
-    for (double target : {next_output, metrics_every_ > 0 ? std::min(next_metrics, end_time_) : end_time_, end_time_}) {
-      const double gap = target - time_;
-      if (gap <= eps) continue;
-      if (dt >= gap - eps) dt = gap;
-      else if (2 * dt > gap) dt = 0.5 * gap;
-    }
-    advance(dt);
+    advance(loop.next_dt);
     check_finite();
-    if (metrics_every_ <= 0 || time_ >= next_metrics - eps || time_ >= end_time_ - eps) {
+    const bool metrics_due = metrics_every_ <= 0 || time_ >= loop.next_metrics - eps || time_ >= end_time_ - eps;
+    if (metrics_due) {
       write_metrics();
-      while (metrics_every_ > 0 && next_metrics <= time_ + eps) next_metrics += metrics_every_;
+      ++loop.metrics_rows;
+      while (metrics_every_ > 0 && loop.next_metrics <= time_ + eps) loop.next_metrics += metrics_every_;
     }
-    if (time_ >= next_output - eps) {
+    const bool frame_due = time_ >= loop.next_output - eps;
+    if (frame_due) {
       write_frame();
-      next_output = output_every_ > 0 ? std::min(next_output + output_every_, end_time_) : end_time_;
-      if (next_output <= time_ + eps) next_output = end_time_ + 1;
+      ++loop.frames;
+      loop.next_output = output_every_ > 0 ? std::min(loop.next_output + output_every_, end_time_) : end_time_;
+      if (loop.next_output <= time_ + eps) loop.next_output = end_time_ + 1;
     }
-    if (progress && std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
+    if (options.progress && std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
       last_print = Clock::now();
       const double wall = std::chrono::duration<double>(last_print - wall_start).count();
-      const double eta = wall * (end_time_ - time_) / std::max(time_, 1e-300);
+      const double eta = wall * (end_time_ - time_) / std::max(time_ - time_start, 1e-300);
       std::cerr << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
                 << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s\n"
                 << std::defaultfloat;
     }
+    if (time_ >= end_time_ - eps) break;
+
+    // A stop request gets readable outputs of this moment; a restart drops them again (they
+    // are not part of the schedule), so the loop counters above leave them out.
+    const int signal = interrupt_signal();
+    if (signal && !metrics_due) write_metrics();
+    if (signal && !frame_due) write_frame();
+    // The next step is chosen before a checkpoint is written, exactly as without one, and
+    // saved with it: a restart continues with the same step and asks no physics for it.
+    loop.next_dt = plan_step(loop);
+    const bool checkpoint_due =
+        (checkpoint_every_steps_ > 0 && step_ % checkpoint_every_steps_ == 0) ||
+        (checkpoint_every_minutes_ > 0 &&
+         std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= 60 * checkpoint_every_minutes_);
+    if (signal || checkpoint_due) {
+      save_checkpoint(out.path(), loop, options.scene);
+      last_checkpoint = Clock::now();
+    }
+    if (signal) throw RunInterrupted(signal, time_, step_);
   }
+  remove_checkpoint(out.path());  // the run is complete: nothing left to resume
 }
 
 }  // namespace frostmpm

@@ -10,11 +10,13 @@
 
 #include "frostmpm/config/config_node.hpp"
 #include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/io/checkpoint.hpp"
 #include "frostmpm/particles/particle_store.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/plugin/registry.hpp"
 #include "frostmpm/scene/model_section.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
+#include "frostmpm/simulation/step_statistics.hpp"
 
 namespace frostmpm {
 
@@ -48,10 +50,22 @@ class NumericalBlowUp : public std::runtime_error {
 };
 inline constexpr int kBlowUpExitCode = 3;
 
-struct StepStatistics {
-  long steps = 0;
-  double dt_min = 0, dt_max = 0, dt_sum = 0;
-  std::map<std::string, double> stage_seconds;
+/// Thrown by Simulation::run when SIGINT or SIGTERM asked it to stop (see interrupt.hpp): the
+/// step in progress was finished, and the checkpoint, the current frame and the metrics row
+/// were written.
+class RunInterrupted : public std::runtime_error {
+ public:
+  RunInterrupted(int signal, double time, long step);
+  int signal;
+  double time;
+  long step;
+};
+
+/// How Simulation::run starts.
+struct RunOptions {
+  bool progress = false;  ///< a progress line on stderr every 2 s of wall time
+  bool restart = false;   ///< continue from out/checkpoint.h5 and append to the outputs there
+  SceneSource scene;      ///< saved in every checkpoint, so a restart needs nothing else
 };
 
 class Simulation {
@@ -64,8 +78,12 @@ class Simulation {
   static std::vector<std::string> sections();
   YAML::Node resolved() const { return resolved_; }
 
-  /// Runs to the end time, writing fields.h5/.xdmf, metrics.csv into `out`.
-  void run(const OutputDir& out, bool progress);
+  /// Runs to the end time, writing fields.h5/.xdmf, metrics.csv into `out`, and checkpoints
+  /// when the scene's `checkpoint:` section says so. A restart re-creates the state of the
+  /// checkpoint exactly, so the run continues bit for bit as if it had never stopped. At the
+  /// normal end the checkpoint is deleted (there is nothing left to resume). Throws
+  /// RunInterrupted after SIGINT/SIGTERM, InputError when a checkpoint cannot be read or written.
+  void run(const OutputDir& out, const RunOptions& options);
 
   // ---- what physics plugins use ----
   const UniformGrid<kDim>& grid() const { return grid_; }
@@ -87,6 +105,8 @@ class Simulation {
   double fixed_dt() const { return fixed_dt_; }
 
   const StepStatistics& statistics() const { return stats_; }
+  /// How often this run was restarted from a checkpoint.
+  long restarts() const { return restarts_; }
   const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
   std::vector<std::string> physics_names() const;
 
@@ -114,7 +134,9 @@ class Simulation {
   std::map<std::string, double> state_defaults_;
   double time_ = 0, dt_ = 0, end_time_ = 0, fixed_dt_ = 0, max_dt_ = 0;
   double output_every_ = 0, metrics_every_ = 0;
-  long step_ = 0;
+  long step_ = 0, restarts_ = 0;
+  long checkpoint_every_steps_ = 0;
+  double checkpoint_every_minutes_ = 0;
   bool positions_changed_ = true;
   StepStatistics stats_;
   YAML::Node resolved_;
@@ -127,9 +149,16 @@ class Simulation {
   void read_boundary_conditions(const ConfigNode& node);
   void read_output(const ConfigNode& node);
   void read_probes(const ConfigNode* node);
+  void read_checkpoint(const ConfigNode& node);
   void apply_initial_values();
   void check_finite() const;
   std::vector<double> evaluate_probes() const;
+  std::string metrics_header() const;
+  /// The next step: stability limits, then cut to land on the next output, metrics or end time.
+  double plan_step(const LoopState& loop) const;
+  void save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene);
+  /// Kernel state, particle fields and persistent arrays from <dir>/checkpoint.h5.
+  LoopState restore_checkpoint(const std::string& dir);
 };
 
 }  // namespace frostmpm

@@ -303,3 +303,37 @@ TEST_CASE("ParticleFieldWriter: 3D fields map to XDMF Scalar, Vector, Tensor6, T
   INFO(result.output);
   REQUIRE(result.exit_code == 0);
 }
+
+TEST_CASE("ParticleFieldWriter: reopen keeps the first frames in step order, drops the rest, appends", "[io]") {
+  require_python_with_h5py();
+  TempDir tmp;
+  const std::string out = tmp.file("out");
+  // Group names sort by step only up to six digits: step_1000000 comes before step_999999.
+  const std::vector<ExpectedFrame> frames = {cloud_2d(0.0, 0, 4), cloud_2d(0.5, 999999, 5),
+                                             cloud_2d(0.75, 1000000, 6), cloud_2d(0.875, 1000001, 2)};
+  {
+    ParticleFieldWriter writer(out, 2);
+    for (const auto& f : frames) write_frame(writer, f);
+  }
+  const ExpectedFrame later = cloud_2d(1.0, 1000002, 3);
+  {
+    ParticleFieldWriter writer = ParticleFieldWriter::reopen(out, 2, 2);
+    REQUIRE(writer.frames() == 2);
+    // The xdmf lists the kept frames at once, as after any write.
+    const auto kept = check_with_reader(tmp, out, {frames[0], frames[1]});
+    INFO(kept.output);
+    REQUIRE(kept.exit_code == 0);
+    REQUIRE_THROWS_AS(write_frame(writer, frames[1]), std::invalid_argument);  // kept: already written
+    write_frame(writer, frames[2]);  // dropped: its step can be written again
+    write_frame(writer, later);
+    REQUIRE(writer.frames() == 4);
+  }
+  const auto result = check_with_reader(tmp, out, {frames[0], frames[1], frames[2], later});
+  INFO(result.output);
+  REQUIRE(result.exit_code == 0);
+
+  REQUIRE_THAT(runtime_error_of([&] { ParticleFieldWriter::reopen(out, 2, 5); }), Contains("fewer than the 5"));
+  REQUIRE_THAT(runtime_error_of([&] { ParticleFieldWriter::reopen(out, 3, 1); }), Contains("2-D frames, not 3-D"));
+  REQUIRE_THAT(runtime_error_of([&] { ParticleFieldWriter::reopen(tmp.file("nowhere"), 2, 0); }),
+               Contains("nowhere/fields.h5"));
+}

@@ -31,7 +31,7 @@ ColumnRun run_column(const ColumnSetup& s) {
   TempDir dir;
   OutputDir out(dir.path());
   const auto start = std::chrono::steady_clock::now();
-  sim.run(out, false);
+  sim.run(out, RunOptions{});
   ColumnRun run;
   run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.steps = sim.statistics().steps;
