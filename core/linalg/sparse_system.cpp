@@ -137,6 +137,10 @@ struct SparseSystem::Impl {
   RCP<const Teuchos::Comm<int>> comm;
   RCP<const Map> map;
   RCP<Matrix> matrix;
+  /// The matrix the preconditioner was built from: a copy, refreshed only when the
+  /// preconditioner is, so a reused preconditioner is a fixed SPD operator even after the
+  /// system's values moved on (smoothers read their matrix when applied).
+  RCP<Matrix> preconditioner_matrix;
   RCP<Vector> b, x, r;
   RCP<Problem> problem;
   RCP<Ifpack2Prec> ifpack2;   ///< jacobi / ilu
@@ -217,6 +221,8 @@ struct SparseSystem::Impl {
     graph->fillComplete();
     matrix = rcp(new Matrix(RCP<const Graph>(graph)));
     matrix->fillComplete();  // all zeros; allocates the value array in its final layout
+    preconditioner_matrix = rcp(new Matrix(RCP<const Graph>(graph)));
+    preconditioner_matrix->fillComplete();
     map_storage_positions();
 
     b = rcp(new Vector(map));
@@ -258,13 +264,20 @@ struct SparseSystem::Impl {
     values_dirty = false;
   }
 
+  void copy_values_to_preconditioner_matrix() {
+    preconditioner_matrix->resumeFill();
+    Kokkos::deep_copy(preconditioner_matrix->getLocalValuesView(), matrix->getLocalValuesView());
+    preconditioner_matrix->fillComplete();
+  }
+
   void build_preconditioner(bool refresh) {
     const auto& kind = options.preconditioner;
+    copy_values_to_preconditioner_matrix();
     if (kind == "jacobi" || kind == "ilu") {
       if (ifpack2.is_null()) {
         // initialize() depends on the graph only, so it runs once; compute() reads the values.
         ifpack2 = Ifpack2::Factory::create<RowMatrix>(kind == "jacobi" ? "RELAXATION" : "RILUK",
-                                                      RCP<const RowMatrix>(matrix));
+                                                      RCP<const RowMatrix>(preconditioner_matrix));
         Teuchos::ParameterList params;
         if (kind == "jacobi") {
           params.set("relaxation: type", "Jacobi");
@@ -295,9 +308,9 @@ struct SparseSystem::Impl {
       // smoothers from the new values (MueLu's "RP" reuse).
       params.set("reuse: type", "RP");
       if (!muelu.is_null() && refresh) {
-        MueLu::ReuseTpetraPreconditioner(matrix, *muelu);
+        MueLu::ReuseTpetraPreconditioner(preconditioner_matrix, *muelu);
       } else {
-        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(matrix), params);
+        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
       }
       problem->setRightPrec(muelu);
     }
@@ -311,9 +324,9 @@ struct SparseSystem::Impl {
   }
 
   /// One Belos run from the current x; returns the iterations it took.
-  int run_krylov(int max_iterations) {
+  int run_krylov(int max_iterations, double tolerance) {
     auto params = rcp(new Teuchos::ParameterList);
-    params->set("Convergence Tolerance", options.tolerance);
+    params->set("Convergence Tolerance", tolerance);
     params->set("Maximum Iterations", max_iterations);
     params->set("Implicit Residual Scaling", "Norm of RHS");
     params->set("Verbosity", static_cast<int>(Belos::Errors));
@@ -338,7 +351,9 @@ struct SparseSystem::Impl {
     return solver->getNumIters();
   }
 
-  SolveStats solve(std::span<const double> rhs, std::span<double> x_io, PreconditionerUpdate update) {
+  SolveStats solve(std::span<const double> rhs, std::span<double> x_io, PreconditionerUpdate update,
+                   double tolerance) {
+    if (!(tolerance > 0)) tolerance = options.tolerance;
     if (rhs.size() != n || x_io.size() != n) {
       throw std::invalid_argument("SparseSystem::solve: rhs and x need " + std::to_string(n) +
                                   " entries (got " + std::to_string(rhs.size()) + " and " +
@@ -384,16 +399,16 @@ struct SparseSystem::Impl {
     // Belos judges convergence on its recursively updated residual; we judge it on the true
     // residual and, if rounding left it above the tolerance, continue from the current x.
     double rel = relative_residual(b_norm);
-    for (int pass = 0; pass < 4 && rel > options.tolerance; ++pass) {
+    for (int pass = 0; pass < 4 && rel > tolerance; ++pass) {
       const int remaining = options.max_iterations - stats.iterations;
       if (remaining <= 0) break;
-      const int its = run_krylov(remaining);
+      const int its = run_krylov(remaining, tolerance);
       stats.iterations += its;
       rel = relative_residual(b_norm);
       if (its == 0) break;  // no progress possible
     }
     stats.relative_residual = rel;
-    stats.converged = std::isfinite(rel) && rel <= options.tolerance;
+    stats.converged = std::isfinite(rel) && rel <= tolerance;
     {
       auto xv = x->getLocalViewHost(Tpetra::Access::ReadOnly);
       for (std::size_t i = 0; i < n; ++i) x_io[i] = xv(i, 0);
@@ -451,11 +466,13 @@ void SparseSystem::add_to_entry(std::size_t row, std::size_t col, double delta) 
 
 SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x,
                                bool rebuild_preconditioner) {
-  return impl_->solve(rhs, x, rebuild_preconditioner ? PreconditionerUpdate::Rebuild : PreconditionerUpdate::Reuse);
+  return impl_->solve(rhs, x, rebuild_preconditioner ? PreconditionerUpdate::Rebuild : PreconditionerUpdate::Reuse,
+                      0.0);
 }
 
-SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update) {
-  return impl_->solve(rhs, x, update);
+SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update,
+                               double tolerance) {
+  return impl_->solve(rhs, x, update, tolerance);
 }
 
 }  // namespace frostmpm

@@ -36,8 +36,9 @@ struct SolveStats {
 
 /// What solve() does with the preconditioner of the previous solve.
 enum class PreconditionerUpdate {
-  Reuse,    ///< apply it as it is (cheapest; safe when the values barely changed — a multigrid
-            ///< smoother reads the current matrix, so after large changes CG may break down)
+  Reuse,    ///< apply it as it is (cheapest): built from a private copy of the values at its
+            ///< last refresh, it stays a fixed symmetric operator however much A changed since
+            ///< (only the iteration count suffers)
   Refresh,  ///< recompute it from the current values, keeping what depends only on the graph
             ///< (Ifpack2: compute(); MueLu: aggregates and prolongators kept, "RP" reuse)
   Rebuild,  ///< build it from scratch
@@ -89,8 +90,11 @@ class SparseSystem {
   /// that is not positive definite).
   SolveStats solve(std::span<const double> rhs, std::span<double> x,
                    bool rebuild_preconditioner = true);
-  /// The same, with a finer choice of what happens to the preconditioner.
-  SolveStats solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update);
+  /// The same, with a finer choice of what happens to the preconditioner and, when tolerance
+  /// > 0, a relative residual for this solve only (an inexact Newton method asks for less
+  /// while far from its solution).
+  SolveStats solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update,
+                   double tolerance = 0.0);
 
  private:
   struct Impl;

@@ -626,8 +626,10 @@ std::ofstream reopen_metrics(const OutputDir& out, const std::string& header, lo
 }  // namespace
 
 void Simulation::run(const OutputDir& out, const RunOptions& options) {
-  // The stencil is needed by the first probe evaluation.
+  // The stencil is needed by the first probe evaluation; it stays valid until particles move
+  // (a physics may key cached grid state to its version).
   stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  positions_changed_ = false;
   // On a restart too: whatever a physics derives from the initial state is set up as in a new
   // run, and the checkpoint then overwrites every field and persistent array.
   for (auto& physics : physics_) physics->initialize();

@@ -51,13 +51,13 @@ class EnthalpyTable {
   }
   double pore_capacity(double T, int i) const { return g1_[i] + 2 * g2_[i] * (T - base_[i]); }
 
-  /// H(T) = s T + φ G(T) for a bulk sensible coefficient s = (1 − φ) C_s (or any a ≥ 0) and
-  /// pore fraction φ (or any b ≥ 0): the form shared by particles and single-material nodes.
+  /// H(T) = a T + b G(T) for a bulk sensible coefficient a = (1 − φ) C_s (or any a ≥ 0) and
+  /// pore fraction b = φ (or any b ≥ 0): the form shared by particles and single-material nodes.
   double heat(double a, double b, double T, int& hint) const {
     hint = locate(T, hint);
     return a * T + b * pore_heat(T, hint);
   }
-  /// The T with a T + b G(T) = H (a + b > 0); `hint` in/out.
+  /// The T with a T + b G(T) = H (a + b > 0), in closed form; `hint` in/out.
   double invert(double a, double b, double H, int& hint) const;
 
   double freezing_point() const { return freezing_point_; }

@@ -11,8 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 #include "frostmpm/parallel/parallel.hpp"
 #include "thermal_physics.hpp"
@@ -60,30 +58,54 @@ void ThermalPhysics::build_graph() {
   system_ = std::make_unique<SparseSystem>(offsets_, columns_, options);
   for (auto* v : {&stiffness_, &free_stiffness_, &matrix_values_}) v->assign(columns_.size(), 0.0);
   for (auto* v : {&boundary_diagonal_, &boundary_load_, &residual_, &rhs_, &increment_, &K_times_T_,
-                  &K_times_increment_, &start_heat_, &start_T_})
+                  &K_times_increment_, &start_heat_, &start_T_, &node_T_before_})
     v->assign(nodes, 0.0);
   graph_version_ = st.version();
+  assembled_conductivity_.clear();  // a new graph is assembled in full
 }
 
-/// K = Σ_p V_p κ_p ∇S_ip·∇S_jp (once per step: κ is fixed within it), and its copy with the
-/// rows and columns of fixed nodes (Dirichlet, empty) replaced by the identity: the Newton
-/// correction is zero there, so no right-hand side changes.
+/// K = Σ_p V_p κ_p ∇S_ip·∇S_jp, once per step (κ is fixed within it). Only the rows of nodes
+/// that see a particle whose κ changed since the last assembly are rebuilt — from every particle
+/// touching them, in the same coloured order as a full assembly, so the result is bitwise what
+/// a full assembly gives (and what a restarted run assembles). Then the copy with the rows and
+/// columns of fixed nodes (Dirichlet, empty) replaced by the identity: the Newton correction is
+/// zero there, so no right-hand side changes.
 void ThermalPhysics::assemble_conductivity() {
   const auto& st = sim_->stencil();
   const auto vol = sim_->particles().field("volume");
   const int K = st.per_particle();
-  std::fill(stiffness_.begin(), stiffness_.end(), 0.0);
-  blocks_.for_each([&](std::size_t p) {
-    const auto* g = st.gradients(p);
-    const int* slot = scatter_.data() + p * K * K;
-    const double a = vol[p] * conductivity_[p];
-    for (int i = 0; i < K; ++i)
-      for (int j = 0; j < K; ++j) {
-        double dot = 0;
-        for (int d = 0; d < kDim; ++d) dot += g[i * kDim + d] * g[j * kDim + d];
-        stiffness_[slot[i * K + j]] += a * dot;
+  const std::size_t n = st.particles();
+  if (assembled_conductivity_.size() != n) assembled_conductivity_.assign(n, std::numeric_limits<double>::quiet_NaN());
+  row_dirty_.assign(node_volume_.size(), 0);
+  bool any = false;
+  for (std::size_t p = 0; p < n; ++p)
+    if (!(conductivity_[p] == assembled_conductivity_[p])) {
+      assembled_conductivity_[p] = conductivity_[p];
+      for (int k = 0; k < K; ++k) row_dirty_[st.nodes(p)[k]] = 1;
+      any = true;
+    }
+  if (any) {
+    parallel_for(node_volume_.size(), [&](std::size_t i) {
+      if (row_dirty_[i]) std::fill(stiffness_.begin() + long(offsets_[i]), stiffness_.begin() + long(offsets_[i + 1]), 0.0);
+    });
+    blocks_.for_each([&](std::size_t p) {
+      const auto* nodes = st.nodes(p);
+      bool touches = false;
+      for (int k = 0; k < K; ++k) touches |= row_dirty_[nodes[k]] != 0;
+      if (!touches) return;
+      const auto* g = st.gradients(p);
+      const int* slot = scatter_.data() + p * K * K;
+      const double a = vol[p] * conductivity_[p];
+      for (int i = 0; i < K; ++i) {
+        if (!row_dirty_[nodes[i]]) continue;
+        for (int j = 0; j < K; ++j) {
+          double dot = 0;
+          for (int d = 0; d < kDim; ++d) dot += g[i * kDim + d] * g[j * kDim + d];
+          stiffness_[slot[i * K + j]] += a * dot;
+        }
       }
-  });
+    });
+  }
   parallel_for(node_volume_.size(), [&](std::size_t i) {
     const bool fixed_row = !is_free(i);
     for (std::size_t e = offsets_[i]; e < offsets_[i + 1]; ++e) {
@@ -182,16 +204,20 @@ bool ThermalPhysics::newton(double t_end, double h) {
       boundary_load_[bc.nodes[j]] += bc.coefficient * bc.areas[j] * ambient;
     }
   }
-  const bool rebuild_every_iteration = params_.string("preconditioner") == "jacobi";
+  // Inexact Newton: each linear solve only needs to shrink the residual in proportion to how far
+  // Newton still is from the solution (Eisenstat–Walker, choice 2), down to linear_tolerance.
+  const double linear_floor = params_.real("linear_tolerance");
+  double previous_worst = 0, forcing = 1e-2;
   for (long it = 1; it <= max_nonlinear_iterations_; ++it) {
     const double worst = nodal_residual(h);
-    if (std::getenv("FROSTMPM_DEBUG_NEWTON")) std::fprintf(stderr, "newton h=%g it=%ld worst=%.3e\n", h, it, worst);
     if (worst <= nonlinear_tolerance_) {
       nonlinear_total_ += it - 1;
       nonlinear_max_ = std::max(nonlinear_max_, it - 1);
       return true;
     }
     if (!std::isfinite(worst)) report_not_finite(t_end, h);
+    if (it > 1) forcing = std::clamp(0.9 * std::pow(worst / previous_worst, 2.0), linear_floor, 1e-2);
+    previous_worst = worst;
     matrix_values_ = free_stiffness_;
     parallel_for(node_T_.size(), [&](std::size_t i) {
       rhs_[i] = -residual_[i];
@@ -200,21 +226,22 @@ bool ThermalPhysics::newton(double t_end, double h) {
         matrix_values_[diagonal_[i]] += node_volume_[i] * nodal_.capacity(i, node_T_[i]) / h + boundary_diagonal_[i];
     });
     system_->set_values(matrix_values_);
+    // The preconditioner is built once per step, from the step's first tangent, and reused by the
+    // later iterations (a private copy of the values keeps it a fixed SPD operator); Jacobi costs
+    // nothing to refresh. A fixed policy keeps restarts bitwise.
+    const auto update = !preconditioner_fresh_ ? PreconditionerUpdate::Rebuild
+                         : params_.string("preconditioner") == "jacobi" ? PreconditionerUpdate::Refresh
+                                                                         : PreconditionerUpdate::Reuse;
     SolveStats stats;
     try {
-      stats = system_->solve(rhs_, increment_,
-                             !preconditioner_fresh_ ? PreconditionerUpdate::Rebuild
-                             : rebuild_every_iteration ? PreconditionerUpdate::Refresh
-                                                       : PreconditionerUpdate::Refresh);
-    } catch (const std::exception& e) {
-      if (std::getenv("FROSTMPM_DEBUG_NEWTON")) std::fprintf(stderr, "   linear solve failed: %s\n", e.what());
+      stats = system_->solve(rhs_, increment_, update, forcing);
+    } catch (const std::exception&) {
       break;  // a breakdown: retried in halves like any failed step
     }
     preconditioner_fresh_ = true;
     linear_total_ += stats.iterations;
     multiply_conductivity(increment_, K_times_increment_);
     const double s = line_search(h);
-    if (std::getenv("FROSTMPM_DEBUG_NEWTON")) std::fprintf(stderr, "   cg its=%d rel=%.2e s=%.3e\n", stats.iterations, stats.relative_residual, s);
     parallel_for(node_T_.size(), [&](std::size_t i) {
       if (is_free(i)) node_T_[i] += s * increment_[i];
     });
@@ -238,8 +265,13 @@ void ThermalPhysics::solve_implicit() {
     start_heat_ = node_heat_;
     start_T_ = node_T_;
     set_dirichlet_targets(t + h);
-    for (std::size_t i = 0; i < nodes; ++i)
+    // First guess: the free nodes continue their last change (the solution does not depend on
+    // it — Ψ is strictly convex — but Newton starts closer).
+    const double ratio = previous_substep_ > 0 ? h / previous_substep_ : 0.0;
+    for (std::size_t i = 0; i < nodes; ++i) {
       if (dirichlet_[i]) node_T_[i] = dirichlet_target_[i];
+      else if (ratio > 0 && node_volume_[i] > 0) node_T_[i] += ratio * (start_T_[i] - node_T_before_[i]);
+    }
     if (!newton(t + h, h)) {
       node_heat_ = start_heat_;
       node_T_ = start_T_;
@@ -258,19 +290,30 @@ void ThermalPhysics::solve_implicit() {
       }
       continue;
     }
-    // Accept: the nodal heat at the new temperatures. Boundary heat of the substep: the flux and
-    // convective flows at the new temperatures, plus the Dirichlet reactions.
+    // Accept. The nodes' heat is updated by the flows at the converged temperatures, so the step
+    // conserves energy to round-off whatever is left of the Newton residual; the temperatures
+    // then follow the heat (they move by less than nonlinear_tolerance). Boundary heat of the
+    // substep: the flux and convective flows, plus the Dirichlet reactions.
     multiply_conductivity(node_T_, K_times_T_);
     double reaction = 0, flows = 0;
     for (std::size_t i = 0; i < nodes; ++i) {
       if (node_volume_[i] <= 0) continue;
       const double flow = boundary_load_[i] - boundary_diagonal_[i] * node_T_[i];
       flows += flow;
-      const double e = nodal_.heat(i, node_T_[i]);
-      if (dirichlet_[i]) reaction += node_volume_[i] * (e - start_heat_[i]) - h * (flow - K_times_T_[i]);
-      node_heat_[i] = e;
+      if (dirichlet_[i]) {
+        const double e = nodal_.heat(i, node_T_[i]);
+        reaction += node_volume_[i] * (e - start_heat_[i]) - h * (flow - K_times_T_[i]);
+        node_heat_[i] = e;
+      } else {
+        node_heat_[i] += h * (flow - K_times_T_[i]) / node_volume_[i];
+      }
     }
     boundary_heat_ += h * flows + reaction;
+    parallel_for(nodes, [&](std::size_t i) {
+      if (is_free(i)) node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+    });
+    node_T_before_ = start_T_;
+    previous_substep_ = h;
     ++substeps_;
     smallest_substep_ = std::min(smallest_substep_, h);
     t += h;

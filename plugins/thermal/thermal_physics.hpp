@@ -114,7 +114,11 @@ class ThermalPhysics final : public Physics {
   std::vector<double> boundary_diagonal_, boundary_load_;  ///< h A_i and q A_i + h A_i T_a
   std::vector<double> residual_, rhs_, increment_, K_times_T_, K_times_increment_, start_heat_, start_T_;
   std::uint64_t graph_version_ = 0;
+  std::vector<double> assembled_conductivity_;  ///< κ_p as in stiffness_
+  std::vector<char> row_dirty_;
   long halvings_ = 0;  ///< the last step's substep level (the next step starts one coarser)
+  std::vector<double> node_T_before_;  ///< nodal T at the start of the last accepted substep
+  double previous_substep_ = 0;       ///< its length (0: no history, e.g. after a re-projection)
   bool preconditioner_fresh_ = false;  ///< built for this step's conductivity matrix
 
   // ---- step and bookkeeping --------------------------------------------------------------------
