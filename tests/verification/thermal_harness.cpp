@@ -1,6 +1,8 @@
 #include "thermal_harness.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <stdexcept>
 #include <fstream>
 #include <sstream>
 
@@ -44,10 +46,18 @@ ColumnRun run_column(const ColumnSetup& s) {
     run.temperature.push_back(T[p]);
     run.temperature_pic.push_back(Tp[p]);
   }
+  for (const auto& physics : sim.physics())
+    for (const auto& [key, value] : physics->statistics()) run.counters[key] = value;
   const CsvTable metrics = read_csv(dir.file("metrics.csv"));
   run.metrics_header = metrics.header;
   run.metrics = metrics.rows;
   return run;
+}
+
+double ColumnRun::last(const std::string& probe) const {
+  const auto it = std::find(metrics_header.begin(), metrics_header.end(), probe);
+  if (it == metrics_header.end()) throw std::out_of_range("metrics.csv has no column " + probe);
+  return metrics.back()[static_cast<std::size_t>(it - metrics_header.begin())];
 }
 
 std::string describe(const ColumnSetup& s, const ColumnRun& run, const std::string& errors) {

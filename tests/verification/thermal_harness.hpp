@@ -2,6 +2,7 @@
 // Runs a verification scene from configs/verification in-process at a chosen resolution and
 // time scheme, and returns the particle temperatures as depth profiles.
 #include <chrono>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,6 +22,9 @@ struct ColumnRun {
   double wall_seconds = 0;
   long steps = 0;
   double mean_dt = 0;
+  std::map<std::string, double> counters;  ///< the physics' run.json counters
+  /// Last metrics.csv value of a probe (fails the test when the column is missing).
+  double last(const std::string& probe) const;
 };
 
 struct ColumnSetup {
