@@ -43,6 +43,41 @@ TEST_CASE("default scene: frozen inclusion thaws within the INTERFROST range", "
   }
 }
 
+TEST_CASE("maximum principle: extreme conductivity in one implicit step, and explicit without latent heat",
+          "[default-scene][max-principle]") {
+  // Initial values span [−5, 5] °C, the left face holds 5 °C, nothing else adds heat: no particle
+  // may leave [−5, 5] °C. FLIP keeps each particle's sub-cell deviation from the grid field (the
+  // inclusion's edge starts inside cells); a particle above its nodes would be pushed past 5 °C
+  // as its nodes warm towards it, unless the update keeps it within its old value and its
+  // nodes' new ones (the overshoot it sheds goes to the grid, energy stays exact).
+  const std::string scene = source_dir() + "/configs/tutorials/frozen_inclusion.yaml";
+  const std::string k = "materials.saturated_sand.";
+  struct Case {
+    const char* name;
+    std::string overrides;
+  };
+  for (const Case& c : {Case{"implicit, k = 1e3 W/m/K, one 36,000 s step",
+                             " --set time.dt=36000 --set time.end=36000 --set output.metrics_every=0 --set " + k +
+                                 "solid_conductivity=1000 --set " + k + "water_conductivity=1000 --set " + k +
+                                 "ice_conductivity=1000"},
+                        Case{"explicit, no latent heat", " --set physics.thermal.scheme=explicit --set time.dt=0 --set " +
+                                                             k + "latent_heat=0 --set time.end=36000"},
+                        Case{"explicit, FLIP without sub-grid relaxation",
+                             " --set physics.thermal.scheme=explicit --set time.dt=0 --set "
+                             "physics.thermal.subgrid_relaxation=0 --set time.end=36000"}}) {
+    INFO(c.name);
+    TempDir dir;
+    const auto r = run_frostmpm("run " + scene + " -o " + dir.file("out") + c.overrides);
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const CsvTable metrics = read_csv(dir.file("out/metrics.csv"));
+    for (const auto& row : metrics.rows) {
+      CHECK(row[metrics.column("T_max")] <= 5.0 + 1e-9);
+      CHECK(row[metrics.column("T_min")] >= -5.0 - 1e-9);
+    }
+  }
+}
+
 TEST_CASE("a thermal-only run allocates no hydraulic or mechanical fields and runs only thermal stages",
           "[default-scene]") {
   TempDir dir;
