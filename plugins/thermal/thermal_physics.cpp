@@ -274,8 +274,14 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
       T_mean += w[k] * node_T_[nodes[k]];
       G_mean += w[k] * G[nodes[k]];
     }
-    d[p] = energy_[p] - (sensible(p, phi[p]) * T_mean + phi[p] * G_mean);
+    const double deviation = energy_[p] - (sensible(p, phi[p]) * T_mean + phi[p] * G_mean);
+    // A deviation at the round-off of the projection is none: it goes to the grid now (exactly),
+    // so that particles in smooth regions carry d = 0 and shed nothing step after step.
+    const bool noise = std::abs(deviation) <= 1e-9 * (std::abs(energy_[p]) + sensible(p, phi[p]));
+    d[p] = noise ? 0.0 : deviation;
+    energy_[p] = noise ? vol[p] * deviation : 0.0;
   });
+  shed_to_grid();
   grid_valid_ = true;
   previous_substep_ = 0;  // no history for the implicit first guess
 }
@@ -359,8 +365,10 @@ void ThermalPhysics::map_to_particles() {
     const double h = sim_->grid().min_spacing();
     keep *= std::exp(-dt_ * max_diffusivity_ / (subgrid_relaxation_ * h * h));
   }
-  long clipped = 0;
-#pragma omp parallel for schedule(static) reduction(+ : clipped)
+  long clipped = 0, shedding = 0;
+  double max_diffusivity = 0, min_capacity = std::numeric_limits<double>::infinity();
+#pragma omp parallel for schedule(static) reduction(+ : clipped, shedding) reduction(max : max_diffusivity) \
+    reduction(min : min_capacity)
   for (std::size_t p = 0; p < n; ++p) {
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
@@ -390,30 +398,36 @@ void ThermalPhysics::map_to_particles() {
       ++clipped;
     }
     energy_[p] = vol[p] * (d[p] - kept);  // deviation given back to the grid
+    shedding += energy_[p] != 0;
     d[p] = kept;
     T[p] = T_new;
     T_pic[p] = T_mean;
     hint_[p] = table.locate(T_new, hint_[p]);
     S[p] = table.saturation(T_new, hint_[p]);
     evaluate_particle_properties(p, phi[p], pic_properties_ ? T_mean : T_new);
+    const double capacity = sensible_capacity(p, phi[p]);
+    max_diffusivity = std::max(max_diffusivity, conductivity_[p] / capacity);
+    min_capacity = std::min(min_capacity, capacity);
   }
   clipped_ += clipped;
-  shed_to_grid();
-  if (!particle_T_.empty()) apply_particle_dirichlet(time_ + dt_, /*count_heat=*/true);
-  update_step_limits();
+  if (shedding > 0) shed_to_grid();
+  max_diffusivity_ = max_diffusivity;
+  min_capacity_ = min_capacity;
+  if (!particle_T_.empty()) {
+    apply_particle_dirichlet(time_ + dt_, /*count_heat=*/true);
+    update_step_limits();
+  }
 }
 
 /// The explicit step's bounds: the largest diffusivity κ/C (sensible capacity, the smaller of
 /// thawed and frozen) and the smallest capacity.
 void ThermalPhysics::update_step_limits() {
   const auto phi = sim_->particles().field("porosity");
-  auto sensible_capacity = [&](std::size_t p) {
-    const auto& pc = constants_[material_[p]];
-    return std::min(pc.capacity(phi[p], 0.0), pc.capacity(phi[p], 1.0));
-  };
   const std::size_t n = phi.size();
-  max_diffusivity_ = parallel_max(n, [&](std::size_t p) { return conductivity_[p] / sensible_capacity(p); }, 0.0);
-  min_capacity_ = parallel_min(n, sensible_capacity, std::numeric_limits<double>::infinity());
+  max_diffusivity_ = parallel_max(
+      n, [&](std::size_t p) { return conductivity_[p] / sensible_capacity(p, phi[p]); }, 0.0);
+  min_capacity_ = parallel_min(
+      n, [&](std::size_t p) { return sensible_capacity(p, phi[p]); }, std::numeric_limits<double>::infinity());
 }
 
 /// Deviation the particles shed this step (the blend, the sub-grid relaxation, the clip) goes
@@ -421,12 +435,10 @@ void ThermalPhysics::update_step_limits() {
 /// (so this step's particle values stay consistent with the nodal temperatures they came
 /// from): E = Σ V_i e_i + Σ_i pending_i + Σ V_p d_p is conserved exactly.
 void ThermalPhysics::shed_to_grid() {
-  const std::size_t n = energy_.size();
-  const bool any = parallel_max(n, [&](std::size_t p) { return std::abs(energy_[p]); }, 0.0) > 0;
-  if (!any) return;
   const auto& st = sim_->stencil();
   const int K = st.per_particle();
   blocks_.for_each([&](std::size_t p) {
+    if (energy_[p] == 0) return;
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
     for (int k = 0; k < K; ++k) node_pending_[nodes[k]] += w[k] * energy_[p];

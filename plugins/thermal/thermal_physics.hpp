@@ -136,6 +136,11 @@ class ThermalPhysics final : public Physics {
   /// (1 − φ) C_s: the solid's share of a particle's heat capacity.
   double sensible(std::size_t p, double phi) const { return (1.0 - phi) * constants_[material_[p]].solid_capacity; }
   void evaluate_particle_properties(std::size_t p, double phi, double T_property);
+  /// The smaller of the thawed and frozen sensible capacities of particle p.
+  double sensible_capacity(std::size_t p, double phi) const {
+    const auto& pc = constants_[material_[p]];
+    return std::min(pc.capacity(phi, 0.0), pc.capacity(phi, 1.0));
+  }
   void update_step_limits();
   void project_to_grid(bool with_heat);
   void invert_nodes();

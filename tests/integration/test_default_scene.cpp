@@ -135,3 +135,29 @@ TEST_CASE("fields.xdmf and fields.h5 load in a real reader with the values writt
   CHECK(low == Approx(metrics.rows.back()[metrics.column("T_min")]).epsilon(1e-10));
   CHECK(high == Approx(metrics.rows.back()[metrics.column("T_max")]).epsilon(1e-10));
 }
+
+TEST_CASE("results are bitwise the same on 1 and 2 threads, explicit and implicit", "[default-scene][threads]") {
+  const std::string scene = source_dir() + "/configs/tutorials/frozen_inclusion.yaml";
+  for (const char* scheme : {"--set physics.thermal.scheme=explicit --set time.dt=0 --set time.end=3600",
+                             "--set time.end=7200"}) {
+    INFO(scheme);
+    TempDir one, two;
+    const auto a = run_command("OMP_NUM_THREADS=1 " + frostmpm_exe() + " run " + scene + " -o " + one.file("out") + " " +
+                               scheme + " 2>&1");
+    const auto b = run_command("OMP_NUM_THREADS=2 " + frostmpm_exe() + " run " + scene + " -o " + two.file("out") + " " +
+                               scheme + " 2>&1");
+    REQUIRE(a.exit_code == 0);
+    REQUIRE(b.exit_code == 0);
+    CHECK(read_file(one.file("out/metrics.csv")) == read_file(two.file("out/metrics.csv")));
+    // Every field of every frame, bitwise (numpy array_equal on what h5py reads).
+    const auto py = run_command("/usr/bin/python3 -c \"import sys; sys.path.insert(0, '" + source_dir() +
+                                "/scripts'); import read_fields, numpy as np\n"
+                                "a = read_fields.read_frames('" + one.file("out") + "')\n"
+                                "b = read_fields.read_frames('" + two.file("out") + "')\n"
+                                "ok = len(a) == len(b) and all(np.array_equal(fa['fields'][k], fb['fields'][k]) "
+                                "for fa, fb in zip(a, b) for k in fa['fields'])\n"
+                                "print('same' if ok else 'differ')\"");
+    INFO(py.output);
+    CHECK(py.output.find("same") != std::string::npos);
+  }
+}
