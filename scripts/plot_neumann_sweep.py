@@ -77,7 +77,7 @@ def main():
     panel(axes[0], rows, lambda r: r["rmse_C"], "profile RMSE at 1 d [°C]",
           "Temperature profile vs two-phase Neumann solution")
     panel(axes[1], rows, lambda r: max(abs(r["front_error_m"]), 1e-6), "|front error| at 1 d [m]",
-          "Thaw depth vs X(1 d) = 2λ√(α_thawed t)")
+          "Thaw front (S_l = ½) vs X(1 d) = 2λ√(α_thawed t)")
     fig.suptitle("Neumann thaw (VERIFICATION.md §1.1): error against wall time (larger marker = finer Δx)",
                  fontsize=11)
     fig.savefig(sys.argv[2], dpi=130)

@@ -8,7 +8,10 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <omp.h>
+
 #include "frostmpm/config/input_error.hpp"
+#include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/checkpoint.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
@@ -163,6 +166,7 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
     summary["plugins"].push_back({{"name", p.name}, {"version", p.version}, {"library", p.file}});
   summary["resolved_scene"] = to_json(prepared->resolved);
   summary["run"] = to_json(prepared->task->summary());
+  summary["threads"] = thread_count();
   summary["wall_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");
@@ -200,6 +204,11 @@ int main(int argc, char** argv) {
                   "continue the run in folder OUT from OUT/checkpoint.h5, appending to its outputs "
                   "(give nothing else: the checkpoint holds the scene, overrides and plugin paths)")
       ->type_name("OUT");
+  int threads = 0;
+  run->add_option("--threads", threads,
+                  "OpenMP threads for particle and node loops (default: OMP_NUM_THREADS, else every core); "
+                  "results do not depend on it")
+      ->check(CLI::Range(1, 1024));
 
   auto* check = cli.add_subcommand("check", "validate a scene and print it with defaults filled in");
   add_scene_options(check, check_options, /*scene_required=*/true);
@@ -225,7 +234,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kInputErrorExitCode;
   }
   try {
-    if (*run) return cmd_run(run_options, out_dir, restart_dir, argv[0]);
+    if (*run) {
+      if (threads > 0) omp_set_num_threads(threads);
+      return cmd_run(run_options, out_dir, restart_dir, argv[0]);
+    }
     if (*check) return cmd_check(check_options);
     if (*plugins) return app::cmd_plugins(list_paths, std::cout);
     if (*describe) return app::cmd_describe(describe_target, markdown, describe_paths, std::cout);

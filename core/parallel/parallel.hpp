@@ -60,10 +60,7 @@ double parallel_max(std::size_t n, F&& f, double empty) {
 /// min f(i) over [0, n) (exact in any order), or `empty` when n = 0.
 template <class F>
 double parallel_min(std::size_t n, F&& f, double empty) {
-  double m = empty;
-#pragma omp parallel for schedule(static) reduction(min : m)
-  for (std::size_t i = 0; i < n; ++i) m = std::min(m, f(i));
-  return m;
+  return -parallel_max(n, [&](std::size_t i) { return -f(i); }, -empty);  // negation is exact
 }
 
 }  // namespace frostmpm

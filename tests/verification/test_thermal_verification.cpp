@@ -165,10 +165,10 @@ void smooth_case(const std::string& scene, const std::string& scheme, Exact&& ex
   CHECK(levels.back().rmse <= finest_rmse);
   const double p = order(levels, &LevelResult::rmse);
   INFO("observed order " << p);
-  // Linear-basis GIMP with particle quadrature on a smooth solution: measured 1.45–1.95
-  // (the FLIP particle values near the surface converge slowest); backward Euler with Δt ∝ h²
-  // keeps the space order.
-  CHECK(p >= 1.4);
+  // Linear-basis GIMP with particle quadrature on a smooth solution: second order (measured
+  // 1.99–2.00 explicit; implicit 1.99, backward Euler with Δt ∝ h² keeping the space order).
+  // Without sub-grid deviations a particle's value is the nodal field at the particle.
+  CHECK(p >= 1.8);
 }
 
 }  // namespace
@@ -213,7 +213,7 @@ TEST_CASE("prescribed heat flux: Carslaw-Jaeger profile and exact energy balance
         CHECK(stored == Approx(entered).epsilon(1e-9));
       }
       CHECK(levels.back().rmse <= 0.01);
-      CHECK(order(levels, &LevelResult::rmse) >= 1.4);
+      CHECK(order(levels, &LevelResult::rmse) >= 1.8);
     }
   }
 }
