@@ -537,7 +537,17 @@ std::string Simulation::metrics_header() const {
 double Simulation::plan_step(const LoopState& loop) const {
   const double eps = 1e-9 * end_time_;
   double dt = fixed_dt_ > 0 ? fixed_dt_ : std::numeric_limits<double>::infinity();
-  for (const auto& physics : physics_) dt = std::min(dt, physics->stable_time_step());
+  for (std::size_t i = 0; i < physics_.size(); ++i) {
+    const double limit = physics_[i]->stable_time_step();
+    // A fixed step above a physics' stability limit is cut to it; say so once.
+    if (fixed_dt_ > 0 && limit < fixed_dt_ * (1 - 1e-12) && !warned_dt_cut_) {
+      std::cerr << "warning: time.dt = " << fixed_dt_ << " s exceeds the stability limit of physics '"
+                << physics_keys_[i] << "' (" << limit << " s at t = " << time_
+                << " s); the run takes the smaller step (an implicit scheme takes any step)\n";
+      warned_dt_cut_ = true;
+    }
+    dt = std::min(dt, limit);
+  }
   if (max_dt_ > 0) dt = std::min(dt, max_dt_);
   if (!std::isfinite(dt)) dt = end_time_ - time_;
   // Land exactly on output, metrics and end times without leaving a sliver step: when the

@@ -138,6 +138,7 @@ class Simulation {
   long checkpoint_every_steps_ = 0;
   double checkpoint_every_minutes_ = 0;
   bool positions_changed_ = true;
+  mutable bool warned_dt_cut_ = false;  ///< the fixed-step warning is given once
   StepStatistics stats_;
   YAML::Node resolved_;
 
