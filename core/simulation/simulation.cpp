@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/scene/region.hpp"
@@ -435,15 +436,16 @@ void Simulation::check_finite() const {
   for (const auto& [name, _] : state_defaults_) {
     const auto column = particles_.field(name);
     const int c = particles_.components(name);
-    for (std::size_t i = 0; i < column.size(); ++i)
-      if (!std::isfinite(column[i])) {
-        const std::size_t p = i / c;
-        std::ostringstream msg;
-        msg << "numerical blow-up: " << name << " = " << column[i] << " at particle " << p << " (x = "
-            << pos[p * kDim] << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_
-            << " (dt = " << dt_ << " s)";
-        throw NumericalBlowUp(msg.str());
-      }
+    // The first non-finite entry (a parallel scan; the smallest index, whatever the threads).
+    const double first = parallel_min(
+        column.size(), [&](std::size_t i) { return std::isfinite(column[i]) ? HUGE_VAL : double(i); }, HUGE_VAL);
+    if (first == HUGE_VAL) continue;
+    const auto i = static_cast<std::size_t>(first);
+    const std::size_t p = i / c;
+    std::ostringstream msg;
+    msg << "numerical blow-up: " << name << " = " << column[i] << " at particle " << p << " (x = " << pos[p * kDim]
+        << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_ << " (dt = " << dt_ << " s)";
+    throw NumericalBlowUp(msg.str());
   }
 }
 
