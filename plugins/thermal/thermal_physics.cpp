@@ -91,8 +91,7 @@ void ThermalPhysics::setup(Simulation& sim) {
     throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
 
   const std::size_t nodes = sim.grid().node_count();
-  for (auto* v : {&node_volume_, &node_heat_, &node_T_, &node_force_, &node_pending_, &dirichlet_value_,
-                  &dirichlet_target_})
+  for (auto* v : {&node_volume_, &node_heat_, &node_T_, &node_force_, &node_pending_, &dirichlet_target_})
     v->assign(nodes, 0.0);
   node_pore_heat_.assign(tables.size(), std::vector<double>(nodes, 0.0));
   dirichlet_.assign(nodes, 0);
@@ -307,7 +306,6 @@ void ThermalPhysics::apply_dirichlet_nodes(double time) {
     for (std::size_t i : bc.nodes) {
       if (node_volume_[i] <= 0) continue;
       dirichlet_[i] = 1;
-      dirichlet_value_[i] = value;
       const double e = nodal_.heat(i, value);
       added += node_volume_[i] * (e - node_heat_[i]);
       node_heat_[i] = e;

@@ -100,7 +100,7 @@ class ThermalPhysics final : public Physics {
   std::vector<double> node_pending_;  ///< heat [J] shed by particles, joins node_heat_ next step
   std::vector<std::vector<double>> node_pore_heat_;  ///< G_m(T_i), per material
   std::vector<char> dirichlet_;
-  std::vector<double> dirichlet_value_, dirichlet_target_;  ///< at the step's start and end
+  std::vector<double> dirichlet_target_;  ///< Dirichlet values at the step's end
   std::uint64_t grid_stencil_version_ = 0;
   bool grid_valid_ = false;  ///< node_heat_ holds the state (carried between steps)
 
