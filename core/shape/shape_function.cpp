@@ -1,6 +1,7 @@
 #include "frostmpm/shape/shape_function.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace frostmpm {
@@ -23,10 +24,12 @@ namespace {
 
 // uGIMP (Bardenhagen & Kober 2004; paper Eq. 58 with a linear grid basis and a hat-shaped
 // particle characteristic function): r = distance to node in cell units, lp = half-width.
-inline void gimp(double r, double lp, double& s, double& ds) {
+// A node within round-off `tol` of the support's edge gets exactly zero: otherwise a particle
+// whose support ends on the grid's last node would hold a ~1e-27 weight on a node past the grid.
+inline void gimp(double r, double lp, double tol, double& s, double& ds) {
   const double a = std::abs(r);
   const double sign = r < 0 ? -1.0 : 1.0;
-  if (a >= 1.0 + lp) {
+  if (a >= 1.0 + lp - tol) {
     s = ds = 0.0;
   } else if (a > 1.0 - lp) {
     const double t = 1.0 + lp - a;
@@ -41,10 +44,10 @@ inline void gimp(double r, double lp, double& s, double& ds) {
   }
 }
 
-inline void bspline(double r, double& s, double& ds) {
+inline void bspline(double r, double tol, double& s, double& ds) {
   const double a = std::abs(r);
   const double sign = r < 0 ? -1.0 : 1.0;
-  if (a >= 2.0) {
+  if (a >= 2.0 - tol) {
     s = ds = 0.0;
   } else if (a >= 1.0) {
     const double t = 2.0 - a;
@@ -60,6 +63,8 @@ inline void bspline(double r, double& s, double& ds) {
 
 int shape_1d(ShapeKind kind, double xi, double h, double half_size, double* weight, double* gradient) {
   const double inv_h = 1.0 / h;
+  // The round-off of xi (a position minus the origin, over h) and of xi − node.
+  const double tol = 16.0 * std::numeric_limits<double>::epsilon() * (std::abs(xi) + 2.0);
   switch (kind) {
     case ShapeKind::Linear: {
       const int base = static_cast<int>(std::floor(xi));
@@ -75,7 +80,7 @@ int shape_1d(ShapeKind kind, double xi, double h, double half_size, double* weig
       const int base = static_cast<int>(std::floor(xi + 0.5)) - 1;
       for (int k = 0; k < 3; ++k) {
         double s, ds;
-        gimp(xi - (base + k), half_size, s, ds);
+        gimp(xi - (base + k), half_size, tol, s, ds);
         weight[k] = s;
         gradient[k] = ds * inv_h;
       }
@@ -85,7 +90,7 @@ int shape_1d(ShapeKind kind, double xi, double h, double half_size, double* weig
       const int base = static_cast<int>(std::floor(xi)) - 1;
       for (int k = 0; k < 4; ++k) {
         double s, ds;
-        bspline(xi - (base + k), s, ds);
+        bspline(xi - (base + k), tol, s, ds);
         weight[k] = s;
         gradient[k] = ds * inv_h;
       }

@@ -401,6 +401,16 @@ void Simulation::read_checkpoint(const ConfigNode& node) {
 
 // ------------------------------------------------------------------------------------------
 
+void Simulation::update_stencil() {
+  const long outside = stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  if (outside < 0) return;
+  const auto pos = particles_.field("position");
+  std::ostringstream msg;
+  msg << "particle " << outside << " at (" << pos[outside * kDim] << ", " << pos[outside * kDim + 1]
+      << ") has support outside the grid at t = " << time_ << " s (step " << step_ << ")";
+  throw NumericalBlowUp(msg.str());
+}
+
 void Simulation::advance(double dt) {
   dt_ = dt;
   auto timed = [&](const std::string& name, const std::function<void()>& fn) {
@@ -409,16 +419,7 @@ void Simulation::advance(double dt) {
     stats_.stage_seconds[name] += std::chrono::duration<double>(Clock::now() - start).count();
   };
   if (positions_changed_) {
-    timed("kernel.stencil", [&] {
-      const long outside = stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
-      if (outside >= 0) {
-        const auto pos = particles_.field("position");
-        std::ostringstream msg;
-        msg << "particle " << outside << " at (" << pos[outside * kDim] << ", " << pos[outside * kDim + 1]
-            << ") left the grid at t = " << time_ << " s (step " << step_ << ")";
-        throw NumericalBlowUp(msg.str());
-      }
-    });
+    timed("kernel.stencil", [&] { update_stencil(); });
     positions_changed_ = false;  // particles move only when a mechanics stage says so
   }
   for (auto& physics : physics_) physics->begin_step(time_, dt);
@@ -640,7 +641,7 @@ std::ofstream reopen_metrics(const OutputDir& out, const std::string& header, lo
 void Simulation::run(const OutputDir& out, const RunOptions& options) {
   // The stencil is needed by the first probe evaluation; it stays valid until particles move
   // (a physics may key cached grid state to its version).
-  stencil_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  update_stencil();
   positions_changed_ = false;
   // On a restart too: whatever a physics derives from the initial state is set up as in a new
   // run, and the checkpoint then overwrites every field and persistent array.

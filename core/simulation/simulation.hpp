@@ -116,6 +116,8 @@ class Simulation {
   double sample_field(const std::string& field, const std::array<double, kDim>& point) const;
 
  private:
+  // Recomputes every particle's stencil; a particle whose support leaves the grid stops the run.
+  void update_stencil();
   struct Probe;
   struct RegionInit;
   const Registry& registry_;

@@ -3,7 +3,10 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "test_support.hpp"
 
@@ -70,4 +73,73 @@ TEST_CASE("bench smoke test: throughput says to build first when frostmpm is mis
                              dir.file("no-such-frostmpm"));
   CHECK(r.exit_code != 0);
   CHECK(r.output.find("build first") != std::string::npos);
+}
+
+namespace {
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::string::size_type start = 0, end;
+  while ((end = text.find(separator, start)) != std::string::npos) {
+    parts.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  parts.push_back(text.substr(start));
+  return parts;
+}
+
+}  // namespace
+
+TEST_CASE("bench smoke test: stability --quick --only cell_size=0.01 prints its table and counts", "[bench]") {
+  TempDir dir;
+  // Two rows (thaw, base cell, explicit and implicit): a few seconds. The format is checked,
+  // not the physics: the sweep itself is the place to read results.
+  const auto r = run_command("/usr/bin/python3 " + source_dir() +
+                             "/bench/stability --quick --only cell_size=0.01 --only case=thaw --frostmpm " +
+                             frostmpm_exe() + " --runs " + dir.file("runs") + " --out " + dir.file("table.csv"));
+  INFO(r.output);
+  REQUIRE((r.exit_code == 0 || r.exit_code == 1));  // 1 = a defect row, still a table
+  CHECK(r.output.find("case   parameter") != std::string::npos);
+  CHECK(r.output.find("thaw   cell_size          0.01 explicit") != std::string::npos);
+  CHECK(r.output.find("thaw   cell_size          0.01 implicit") != std::string::npos);
+  // The counts line: three categories adding up to the two runs.
+  const auto at = r.output.find(" accurate, ");
+  REQUIRE(at != std::string::npos);
+  const auto line_start = r.output.rfind('\n', at) + 1;
+  int accurate = -1, stopped = -1, defect = -1, runs = -1;
+  REQUIRE(std::sscanf(r.output.c_str() + line_start, "%d accurate, %d clean stop, %d defect (%d runs", &accurate,
+                      &stopped, &defect, &runs) == 4);
+  CHECK(accurate + stopped + defect == 2);
+  CHECK(runs == 2);
+  CHECK((r.exit_code == 1) == (defect > 0));
+
+  const auto lines = split(read_file(dir.file("table.csv")), '\n');
+  REQUIRE(lines.size() >= 3);
+  const auto header = split(lines[0], ',');
+  CHECK(header == std::vector<std::string>{"case", "parameter", "value", "scheme", "cell_m", "t_end_s", "dt_max_s",
+                                           "steps", "result", "front_error", "front_tol", "rmse_of_range",
+                                           "rmse_tol", "energy_error_rel", "fields_energy_rel", "wall_s", "notes"});
+  std::set<std::string> schemes;
+  for (int row = 1; row <= 2; ++row) {
+    const auto cells = split(lines[row], ',');
+    REQUIRE(cells.size() >= header.size());
+    CHECK(cells[0] == "thaw");
+    CHECK(cells[1] == "cell_size");
+    CHECK(std::stod(cells[2]) == 0.01);
+    schemes.insert(cells[3]);
+    CHECK(std::set<std::string>{"accurate", "clean stop", "defect"}.count(cells[8]) == 1);
+    if (cells[8] == "accurate")  // every measure of an accurate row is a finite number
+      for (int c : {4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 15}) {
+        INFO(header[c] << " = " << cells[c]);
+        CHECK(std::isfinite(std::stod(cells[c])));
+      }
+  }
+  CHECK(schemes == std::set<std::string>{"explicit", "implicit"});
+}
+
+TEST_CASE("bench smoke test: stability names the valid keys of a bad --only", "[bench]") {
+  const auto r = run_command("/usr/bin/python3 " + source_dir() + "/bench/stability --only cell=0.01 --frostmpm " +
+                             frostmpm_exe());
+  CHECK(r.exit_code != 0);
+  CHECK(r.output.find("cell_size") != std::string::npos);
 }

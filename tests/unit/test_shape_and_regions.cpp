@@ -2,6 +2,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "frostmpm/config/config_node.hpp"
 #include "frostmpm/grid/uniform_grid.hpp"
@@ -78,6 +80,39 @@ TEST_CASE("a particle outside the grid is reported by the stencil cache", "[shap
   cache.configure(ShapeKind::Linear);
   std::vector<double> pos = {0.5, 0.5, 1.5, 0.5}, half = {0.025, 0.05, 0.025, 0.05};
   REQUIRE(cache.update(grid, pos, half) == 1);
+}
+
+TEST_CASE("GIMP particles filling the grid to its edge stay inside it for any cell size", "[shape]") {
+  // Round-off in (x − origin)/h once gave the node past the last one a ~1e-27 weight, so the
+  // particle in the last cell counted as outside and lost its whole stencil (bench/stability,
+  // freezing at Δx = 0.0237… m; 100 cells of 5 cm or 10 cm too).
+  for (const double h : {0.023705193823151, 0.05, 0.1, 0.01, 1e-3, 10.0, 0.3, 0.07}) {
+    for (const int n : {7, 100, 333, 1000}) {
+      INFO("h = " << h << ", " << n << " cells");
+      UniformGrid<2> grid;
+      grid.spacing = {h, h};
+      grid.cells = {1, n};
+      grid.ghost_layers = ghost_layers(ShapeKind::Gimp);
+      std::ostringstream yaml;
+      yaml << std::setprecision(17) << "box: {min: [0, 0], max: [" << h << ", " << n * h << "]}";
+      const auto box = ConfigNode::load_string(yaml.str());
+      const auto points = sample_region(grid, read_region_shape(box), 2);
+      REQUIRE(points.size() == static_cast<std::size_t>(4 * n));
+      std::vector<double> pos, half;
+      for (const auto& p : points) {
+        pos.insert(pos.end(), {p[0], p[1]});
+        half.insert(half.end(), {h / 4, h / 4});
+      }
+      StencilCache<2> cache;
+      cache.configure(ShapeKind::Gimp);
+      REQUIRE(cache.update(grid, pos, half) == -1);
+      for (std::size_t p = 0; p < points.size(); ++p) {
+        double sum = 0;
+        for (int k = 0; k < cache.per_particle(); ++k) sum += cache.weights(p)[k];
+        REQUIRE(sum == Approx(1.0).margin(1e-12));
+      }
+    }
+  }
 }
 
 TEST_CASE("regions: box, disk, half-disk and polygon fill their area with n×n particles per cell", "[regions]") {
