@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <optional>
 
 #include <CLI/CLI.hpp>
@@ -185,6 +186,9 @@ int cmd_check(const SceneOptions& o) {
   YAML::Emitter emitter;
   emitter << prepared->resolved;
   std::cout << "# " << o.scene << ": valid. Resolved scene with defaults:\n" << emitter.c_str() << "\n";
+  // The resolved step as YAML comments, so that the output stays a loadable scene.
+  std::istringstream step(prepared->task->step_description());
+  for (std::string line; std::getline(step, line);) std::cout << "# " << line << "\n";
   return 0;
 }
 

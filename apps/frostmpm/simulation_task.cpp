@@ -15,6 +15,7 @@ class SimulationTask final : public Task {
 
   std::vector<std::string> sections() const override { return Simulation::sections(); }
   YAML::Node resolved() const override { return sim_.resolved(); }
+  std::string step_description() const override { return sim_.step_plan().describe(); }
   void execute(const OutputDir& out, const RunRequest& request) override {
     RunOptions options;
     options.progress = sim_.resolved()["output"]["progress"].as<bool>();

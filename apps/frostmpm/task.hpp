@@ -36,6 +36,9 @@ class Task {
   /// The scene as it will run: every section with defaults filled in.
   virtual YAML::Node resolved() const = 0;
   virtual void execute(const OutputDir& out, const RunRequest& request) = 0;
+  /// What one step runs (phases, stages, fields), for `frostmpm check`; empty when the task
+  /// has no steps.
+  virtual std::string step_description() const { return {}; }
   /// Task-specific facts for run.json (steps, timings, counters).
   virtual YAML::Node summary() const { return {}; }
 };

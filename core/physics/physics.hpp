@@ -1,13 +1,16 @@
 #pragma once
 // A physics plugin contributes coupled equations to the step: it declares the particle fields
-// it needs, the material parameters and model slots it reads, the boundary-condition types it
-// owns, and the ordered stages it adds to the step. The kernel never names a physical model.
+// it keeps, the material parameters and model slots it reads, the boundary-condition types it
+// owns, and the stages it hooks into the kernel's phases, each with the fields it reads and
+// writes (core/step/stage.hpp). Physics couple through those named fields only; the kernel
+// orders the step from the declarations and never names a physical model.
 #include <functional>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "frostmpm/config/param_schema.hpp"
+#include "frostmpm/step/stage.hpp"
 
 namespace frostmpm {
 
@@ -28,12 +31,6 @@ struct PersistentArray {
   std::vector<double>* values = nullptr;
 };
 
-/// One stage of the step; the scheduler times each by name for run.json.
-struct Stage {
-  std::string name;
-  std::function<void()> run;
-};
-
 class Physics {
  public:
   static constexpr const char* kKind = "physics";
@@ -49,6 +46,8 @@ class Physics {
   /// Called once after particles exist: declare fields, read materials and boundary
   /// conditions from `sim`, validate everything; stages() is valid afterwards.
   virtual void setup(Simulation& sim) = 0;
+  /// The stages this physics adds to the step, with their phases and the fields they read and
+  /// write. Called once, after every physics' setup(); nodal fields exist from initialize() on.
   virtual std::vector<Stage> stages() = 0;
 
   /// Called once before the first output, after initial values are set: bring derived

@@ -14,7 +14,7 @@
 namespace frostmpm {
 
 /// Bumped whenever an interface in core/ changes layout or virtual table.
-inline constexpr const char* kKernelAbiTag = "frostmpm-abi-1";
+inline constexpr const char* kKernelAbiTag = "frostmpm-abi-2";
 
 struct PluginInfo {
   const char* name;

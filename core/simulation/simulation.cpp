@@ -28,6 +28,10 @@ std::array<double, kDim> read_point(const ConfigNode& node) {
 
 using Clock = std::chrono::steady_clock;
 
+/// Checkpoint group of the nodal fields the kernel carries between steps (no physics key
+/// starts with an underscore).
+constexpr const char* kCarriedNodeFields = "_carried_node_fields";
+
 }  // namespace
 
 // ------------------------------------------------------------------------------------------
@@ -61,8 +65,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   else resolved_["boundary_conditions"] = YAML::Node(YAML::NodeType::Sequence);
   for (auto& physics : physics_) physics->setup(*this);
   for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
-  for (auto& physics : physics_)
-    for (auto& stage : physics->stages()) stages_.push_back(std::move(stage));
+  resolve_step();
   apply_initial_values();
   read_output(root.child("output"));
   const auto probes = root.optional_child("probes");
@@ -127,6 +130,7 @@ void Simulation::read_physics(const ConfigNode& node) {
     const ParamSet params = parse_params(entry.schema, section);
     physics_.push_back(registry_.create<Physics>(key, params, section.where()));
     physics_keys_.push_back(key);
+    physics_where_.push_back(section.where());
     resolved[key] = params.to_yaml();
   }
   resolved_["physics"] = resolved;
@@ -294,6 +298,22 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
   resolved_["boundary_conditions"] = YAML::Clone(node.raw());
 }
 
+void Simulation::resolve_step() {
+  std::vector<StepPlan::Declared> declared;
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    for (auto& stage : physics_[i]->stages()) declared.push_back({std::move(stage), physics_keys_[i], physics_where_[i]});
+  plan_ = StepPlan::resolve(std::move(declared), particles_.field_names());
+  for (const auto& f : plan_.new_particle_fields()) particles_.declare(f.name, f.components);
+  for (const auto& f : plan_.node_fields()) node_fields_.allocate(f.name, f.components, grid_.node_count());
+}
+
+std::vector<PersistentArray> Simulation::carried_node_fields() {
+  std::vector<PersistentArray> arrays;
+  for (const auto& f : plan_.node_fields())
+    if (f.carried) arrays.push_back({f.name, &node_fields_.values(f.name)});
+  return arrays;
+}
+
 std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::string& type) {
   std::vector<BoundaryCondition*> out;
   for (auto& bc : bcs_)
@@ -423,7 +443,7 @@ void Simulation::advance(double dt) {
     positions_changed_ = false;  // particles move only when a mechanics stage says so
   }
   for (auto& physics : physics_) physics->begin_step(time_, dt);
-  for (auto& stage : stages_) timed(stage.name, stage.run);
+  for (auto& stage : plan_.stages()) timed(stage.name, stage.run);
   time_ += dt;
   ++step_;
   stats_.steps++;
@@ -578,6 +598,8 @@ void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const 
   checkpoint.write(particles_);
   for (std::size_t i = 0; i < physics_.size(); ++i)
     checkpoint.write_physics(physics_keys_[i], physics_[i]->persistent_state());
+  if (const auto carried = carried_node_fields(); !carried.empty())
+    checkpoint.write_physics(kCarriedNodeFields, carried);
   checkpoint.commit();
   stats_.stage_seconds["kernel.checkpoint"] += std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -587,6 +609,8 @@ LoopState Simulation::restore_checkpoint(const std::string& dir) {
   checkpoint.read(particles_);
   for (std::size_t i = 0; i < physics_.size(); ++i)
     checkpoint.read_physics(physics_keys_[i], physics_[i]->persistent_state());
+  if (const auto carried = carried_node_fields(); !carried.empty())
+    checkpoint.read_physics(kCarriedNodeFields, carried);
   LoopState loop = checkpoint.loop();
   time_ = loop.time;
   step_ = loop.step;

@@ -17,6 +17,8 @@
 #include "frostmpm/scene/model_section.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
 #include "frostmpm/simulation/step_statistics.hpp"
+#include "frostmpm/step/node_fields.hpp"
+#include "frostmpm/step/step_plan.hpp"
 
 namespace frostmpm {
 
@@ -90,6 +92,11 @@ class Simulation {
   ParticleStore& particles() { return particles_; }
   const ParticleStore& particles() const { return particles_; }
   const StencilCache<kDim>& stencil() const { return stencil_; }
+  /// Nodal fields the stages of this scene read or write (allocated after every setup()).
+  NodeFields& node_fields() { return node_fields_; }
+  const NodeFields& node_fields() const { return node_fields_; }
+  /// The resolved step: stages in order, with their phases, reads and writes.
+  const StepPlan& step_plan() const { return plan_; }
   const std::vector<Material>& materials() const { return materials_; }
   const Registry& registry() const { return registry_; }
   /// Boundary conditions whose type a physics owns.
@@ -129,7 +136,9 @@ class Simulation {
   std::vector<BoundaryCondition> bcs_;
   std::vector<std::shared_ptr<Physics>> physics_;
   std::vector<std::string> physics_keys_;
-  std::vector<Stage> stages_;
+  std::vector<SourceLocation> physics_where_;  ///< each physics' section, for errors
+  StepPlan plan_;
+  NodeFields node_fields_;
   std::vector<RegionInit> region_inits_;
   std::vector<std::unique_ptr<Probe>> probes_;
   std::vector<std::string> output_fields_;
@@ -153,6 +162,9 @@ class Simulation {
   void read_output(const ConfigNode& node);
   void read_probes(const ConfigNode* node);
   void read_checkpoint(const ConfigNode& node);
+  void resolve_step();
+  /// Nodal fields kept between steps, for checkpoints.
+  std::vector<PersistentArray> carried_node_fields();
   void apply_initial_values();
   void check_finite() const;
   std::vector<double> evaluate_probes() const;

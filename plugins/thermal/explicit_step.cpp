@@ -19,7 +19,7 @@ void ThermalPhysics::conduction_force() {
     const auto* g = st.gradients(p);
     double grad[kDim] = {};
     for (int k = 0; k < K; ++k)
-      for (int d = 0; d < kDim; ++d) grad[d] += node_T_[nodes[k]] * g[k * kDim + d];
+      for (int d = 0; d < kDim; ++d) grad[d] += (*node_T_)[nodes[k]] * g[k * kDim + d];
     const double a = vol[p] * conductivity_[p];
     for (int k = 0; k < K; ++k) {
       double dot = 0;
@@ -54,7 +54,7 @@ double ThermalPhysics::boundary_flow(double time, const std::vector<double>& T, 
 
 void ThermalPhysics::solve_explicit() {
   conduction_force();
-  const double boundary = boundary_flow(time_, node_T_, node_force_);
+  const double boundary = boundary_flow(time_, (*node_T_), node_force_);
   // Dirichlet nodes are reset to their target; what that takes beyond the heat the node's
   // neighbours and boundary flows gave it is the boundary's (the reaction).
   double reaction = 0;
@@ -63,13 +63,13 @@ void ThermalPhysics::solve_explicit() {
       const double target = nodal_.heat(i, dirichlet_target_[i]);
       reaction += node_volume_[i] * (target - node_heat_[i]) - dt_ * node_force_[i];
       node_heat_[i] = target;
-      node_T_[i] = dirichlet_target_[i];
+      (*node_T_)[i] = dirichlet_target_[i];
     }
   boundary_heat_ += dt_ * boundary + reaction;
   parallel_for(node_heat_.size(), [&](std::size_t i) {
     if (!is_free(i)) return;
     node_heat_[i] += dt_ * node_force_[i] / node_volume_[i];
-    node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+    (*node_T_)[i] = nodal_.invert(i, node_heat_[i], (*node_T_)[i]);
   });
 }
 

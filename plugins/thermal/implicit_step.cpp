@@ -126,17 +126,17 @@ void ThermalPhysics::multiply_conductivity(const std::vector<double>& x, std::ve
 /// R(T) into residual_ (zero at fixed nodes) and K T into K_times_T_; returns the largest
 /// residual as temperature: max |R_i| Δt / (V_i C_i) with C_i the node's sensible capacity.
 double ThermalPhysics::nodal_residual(double h) {
-  multiply_conductivity(node_T_, K_times_T_);
+  multiply_conductivity((*node_T_), K_times_T_);
   return parallel_max(
-      node_T_.size(),
+      (*node_T_).size(),
       [&](std::size_t i) {
         if (!is_free(i)) {
           residual_[i] = 0;
           return 0.0;
         }
-        const double Hi = nodal_.heat(i, node_T_[i]);
+        const double Hi = nodal_.heat(i, (*node_T_)[i]);
         residual_[i] = node_volume_[i] * (Hi - node_heat_[i]) / h + K_times_T_[i] +
-                       boundary_diagonal_[i] * node_T_[i] - boundary_load_[i];
+                       boundary_diagonal_[i] * (*node_T_)[i] - boundary_load_[i];
         const double worst = std::abs(residual_[i]) * h / (node_volume_[i] * nodal_.min_capacity(i));
         return std::isfinite(worst) ? worst : std::numeric_limits<double>::infinity();
       },
@@ -147,9 +147,9 @@ double ThermalPhysics::nodal_residual(double h) {
 /// φ'(s) = δ·R(T + s δ), by the Illinois variant of regula falsi, to 10 % of φ'(0).
 double ThermalPhysics::line_search(double h) {
   auto slope = [&](double s) {
-    return reproducible_sum(node_T_.size(), [&](std::size_t i) {
+    return reproducible_sum((*node_T_).size(), [&](std::size_t i) {
       if (!is_free(i) || increment_[i] == 0) return 0.0;
-      const double Ti = node_T_[i] + s * increment_[i];
+      const double Ti = (*node_T_)[i] + s * increment_[i];
       const double Ri = node_volume_[i] * (nodal_.heat(i, Ti) - node_heat_[i]) / h + K_times_T_[i] +
                         s * K_times_increment_[i] + boundary_diagonal_[i] * Ti - boundary_load_[i];
       return increment_[i] * Ri;
@@ -181,7 +181,7 @@ double ThermalPhysics::line_search(double h) {
 
 void ThermalPhysics::report_not_finite(double t_end, double h) const {
   std::size_t i = 0;
-  while (i + 1 < residual_.size() && std::isfinite(residual_[i]) && std::isfinite(node_T_[i])) ++i;
+  while (i + 1 < residual_.size() && std::isfinite(residual_[i]) && std::isfinite((*node_T_)[i])) ++i;
   const auto x = sim_->grid().node_position(i);
   std::ostringstream msg;
   msg << "numerical blow-up: temperature equation not finite at grid node " << i << " (x = " << x[0] << ", y = " << x[1]
@@ -219,11 +219,11 @@ bool ThermalPhysics::newton(double t_end, double h) {
     if (it > 1) forcing = std::clamp(0.9 * std::pow(worst / previous_worst, 2.0), linear_floor, 1e-2);
     previous_worst = worst;
     matrix_values_ = free_stiffness_;
-    parallel_for(node_T_.size(), [&](std::size_t i) {
+    parallel_for((*node_T_).size(), [&](std::size_t i) {
       rhs_[i] = -residual_[i];
       increment_[i] = 0.0;
       if (is_free(i))
-        matrix_values_[diagonal_[i]] += node_volume_[i] * nodal_.capacity(i, node_T_[i]) / h + boundary_diagonal_[i];
+        matrix_values_[diagonal_[i]] += node_volume_[i] * nodal_.capacity(i, (*node_T_)[i]) / h + boundary_diagonal_[i];
     });
     system_->set_values(matrix_values_);
     // The preconditioner is built once per step, from the step's first tangent, and reused by the
@@ -242,8 +242,8 @@ bool ThermalPhysics::newton(double t_end, double h) {
     linear_total_ += stats.iterations;
     multiply_conductivity(increment_, K_times_increment_);
     const double s = line_search(h);
-    parallel_for(node_T_.size(), [&](std::size_t i) {
-      if (is_free(i)) node_T_[i] += s * increment_[i];
+    parallel_for((*node_T_).size(), [&](std::size_t i) {
+      if (is_free(i)) (*node_T_)[i] += s * increment_[i];
     });
   }
   nonlinear_total_ += max_nonlinear_iterations_;
@@ -255,7 +255,7 @@ void ThermalPhysics::solve_implicit() {
   if (!system_ || st.version() != graph_version_) build_graph();
   assemble_conductivity();
   preconditioner_fresh_ = false;  // the tangent's off-diagonal part changed with κ
-  const std::size_t nodes = node_T_.size();
+  const std::size_t nodes = (*node_T_).size();
   const double end = time_ + dt_;
   long level = std::max(0L, halvings_ - 1);  // start one level coarser than last time
   double t = time_;
@@ -263,18 +263,18 @@ void ThermalPhysics::solve_implicit() {
     double h = std::min(dt_ / std::ldexp(1.0, int(level)), end - t);
     if (end - t - h < 1e-9 * dt_) h = end - t;
     start_heat_ = node_heat_;
-    start_T_ = node_T_;
+    start_T_ = (*node_T_);
     set_dirichlet_targets(t + h);
     // First guess: the free nodes continue their last change (the solution does not depend on
     // it — Ψ is strictly convex — but Newton starts closer).
     const double ratio = previous_substep_ > 0 ? h / previous_substep_ : 0.0;
     for (std::size_t i = 0; i < nodes; ++i) {
-      if (dirichlet_[i]) node_T_[i] = dirichlet_target_[i];
-      else if (ratio > 0 && node_volume_[i] > 0) node_T_[i] += ratio * (start_T_[i] - node_T_before_[i]);
+      if (dirichlet_[i]) (*node_T_)[i] = dirichlet_target_[i];
+      else if (ratio > 0 && node_volume_[i] > 0) (*node_T_)[i] += ratio * (start_T_[i] - node_T_before_[i]);
     }
     if (!newton(t + h, h)) {
       node_heat_ = start_heat_;
-      node_T_ = start_T_;
+      (*node_T_) = start_T_;
       ++rejected_substeps_;
       if (++level > max_step_halvings_) {
         std::size_t worst = 0;
@@ -294,14 +294,14 @@ void ThermalPhysics::solve_implicit() {
     // conserves energy to round-off whatever is left of the Newton residual; the temperatures
     // then follow the heat (they move by less than nonlinear_tolerance). Boundary heat of the
     // substep: the flux and convective flows, plus the Dirichlet reactions.
-    multiply_conductivity(node_T_, K_times_T_);
+    multiply_conductivity((*node_T_), K_times_T_);
     double reaction = 0, flows = 0;
     for (std::size_t i = 0; i < nodes; ++i) {
       if (node_volume_[i] <= 0) continue;
-      const double flow = boundary_load_[i] - boundary_diagonal_[i] * node_T_[i];
+      const double flow = boundary_load_[i] - boundary_diagonal_[i] * (*node_T_)[i];
       flows += flow;
       if (dirichlet_[i]) {
-        const double e = nodal_.heat(i, node_T_[i]);
+        const double e = nodal_.heat(i, (*node_T_)[i]);
         reaction += node_volume_[i] * (e - start_heat_[i]) - h * (flow - K_times_T_[i]);
         node_heat_[i] = e;
       } else {
@@ -310,7 +310,7 @@ void ThermalPhysics::solve_implicit() {
     }
     boundary_heat_ += h * flows + reaction;
     parallel_for(nodes, [&](std::size_t i) {
-      if (is_free(i)) node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+      if (is_free(i)) (*node_T_)[i] = nodal_.invert(i, node_heat_[i], (*node_T_)[i]);
     });
     node_T_before_ = start_T_;
     previous_substep_ = h;

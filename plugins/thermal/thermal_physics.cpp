@@ -91,7 +91,7 @@ void ThermalPhysics::setup(Simulation& sim) {
     throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
 
   const std::size_t nodes = sim.grid().node_count();
-  for (auto* v : {&node_volume_, &node_heat_, &node_T_, &node_force_, &node_pending_, &dirichlet_target_})
+  for (auto* v : {&node_volume_, &node_heat_, &node_force_, &node_pending_, &dirichlet_target_})
     v->assign(nodes, 0.0);
   node_pore_heat_.assign(tables.size(), std::vector<double>(nodes, 0.0));
   dirichlet_.assign(nodes, 0);
@@ -104,9 +104,18 @@ void ThermalPhysics::setup(Simulation& sim) {
 }
 
 std::vector<Stage> ThermalPhysics::stages() {
-  return {{"thermal.map_to_grid", [this] { map_to_grid(); }},
-          {"thermal.solve", [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
-          {"thermal.map_to_particles", [this] { map_to_particles(); }}};
+  // What other physics may use: the nodal temperature (node field 'temperature', after the
+  // solve the end-of-step value) and the particle fields. The nodal heat content and the
+  // step's work arrays stay private.
+  const auto T = particle_field("temperature"), d = particle_field("heat_deviation"),
+             phi = particle_field("porosity"), vol = particle_field("volume"), x = particle_field("position", kDim);
+  const auto T_node = node_field("temperature");
+  return {{"thermal.map_to_grid", Phase::MapToGrid, {x, vol, phi, T, d}, {T_node}, [this] { map_to_grid(); }},
+          {"thermal.solve", Phase::Energy, {T_node}, {T_node},
+           [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
+          {"thermal.map_to_particles", Phase::MapToParticles, {T_node, x, vol, phi, T, d},
+           {T, d, particle_field("temperature_pic"), particle_field("liquid_saturation")},
+           [this] { map_to_particles(); }}};
 }
 
 void ThermalPhysics::read_boundaries(Simulation& sim) {
@@ -175,6 +184,7 @@ double ThermalPhysics::particle_heat_total() const {
 }
 
 void ThermalPhysics::initialize() {
+  node_T_ = &sim_->node_fields().values("temperature");
   auto& particles = sim_->particles();
   auto T = particles.field("temperature");
   auto T_pic = particles.field("temperature_pic");
@@ -250,7 +260,7 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
     const double V = node_volume_[i];
     if (V <= 0) {
       nodal_.material[i] = NodalHeat::kEmpty;
-      node_heat_[i] = node_T_[i] = 0;
+      node_heat_[i] = (*node_T_)[i] = 0;
       return;
     }
     nodal_.sensible[i] /= V;
@@ -270,7 +280,7 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
     const auto& G = node_pore_heat_[material_[p]];
     double T_mean = 0, G_mean = 0;
     for (int k = 0; k < K; ++k) {
-      T_mean += w[k] * node_T_[nodes[k]];
+      T_mean += w[k] * (*node_T_)[nodes[k]];
       G_mean += w[k] * G[nodes[k]];
     }
     const double deviation = energy_[p] - (sensible(p, phi[p]) * T_mean + phi[p] * G_mean);
@@ -287,14 +297,14 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
 
 void ThermalPhysics::invert_nodes() {
   parallel_for(node_heat_.size(), [&](std::size_t i) {
-    if (node_volume_[i] > 0) node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+    if (node_volume_[i] > 0) (*node_T_)[i] = nodal_.invert(i, node_heat_[i], (*node_T_)[i]);
   });
 }
 
 void ThermalPhysics::update_node_pore_heat() {
-  parallel_for(node_T_.size(), [&](std::size_t i) {
+  parallel_for((*node_T_).size(), [&](std::size_t i) {
     for (std::size_t m = 0; m < node_pore_heat_.size(); ++m)
-      node_pore_heat_[m][i] = nodal_.pore[m][i] > 0 ? nodal_.pore_heat(m, i, node_T_[i]) : 0.0;
+      node_pore_heat_[m][i] = nodal_.pore[m][i] > 0 ? nodal_.pore_heat(m, i, (*node_T_)[i]) : 0.0;
   });
 }
 
@@ -309,7 +319,7 @@ void ThermalPhysics::apply_dirichlet_nodes(double time) {
       const double e = nodal_.heat(i, value);
       added += node_volume_[i] * (e - node_heat_[i]);
       node_heat_[i] = e;
-      node_T_[i] = value;
+      (*node_T_)[i] = value;
     }
   }
   boundary_heat_ += added;
@@ -332,7 +342,7 @@ void ThermalPhysics::map_to_grid() {
     parallel_for(node_heat_.size(), [&](std::size_t i) {
       if (node_volume_[i] > 0 && node_pending_[i] != 0) {
         node_heat_[i] += node_pending_[i] / node_volume_[i];
-        node_T_[i] = nodal_.invert(i, node_heat_[i], node_T_[i]);
+        (*node_T_)[i] = nodal_.invert(i, node_heat_[i], (*node_T_)[i]);
       }
     });
     std::fill(node_pending_.begin(), node_pending_.end(), 0.0);
@@ -374,7 +384,7 @@ void ThermalPhysics::map_to_particles() {
     const auto& table = *tables_[material_[p]];
     double T_mean = 0, G_mean = 0, lo = T[p], hi = T[p];
     for (int k = 0; k < K; ++k) {
-      const double Ti = node_T_[nodes[k]];
+      const double Ti = (*node_T_)[nodes[k]];
       T_mean += w[k] * Ti;
       G_mean += w[k] * G[nodes[k]];
       if (w[k] > 0) {
@@ -473,7 +483,7 @@ std::vector<PersistentArray> ThermalPhysics::persistent_state() {
                     double(nonlinear_max_), double(linear_total_), double(rejected_substeps_), double(substeps_),
                     double(clipped_), smallest_substep_, max_diffusivity_, min_capacity_, double(initialized_)};
   return {{"node_heat", &node_heat_},
-          {"node_temperature", &node_T_},
+          {"node_temperature", node_T_},
           {"node_temperature_before", &node_T_before_},
           {"node_pending_heat", &node_pending_},
           {"scalars", &saved_scalars_}};
@@ -508,10 +518,10 @@ void ThermalPhysics::restored() {
     evaluate_particle_properties(p, phi[p], pic_properties_ ? T_pic[p] : T[p]);
   });
   if (grid_valid_) {  // the grid's coefficients again; its state exactly as saved
-    const std::vector<double> heat = node_heat_, temperature = node_T_;
+    const std::vector<double> heat = node_heat_, temperature = (*node_T_);
     project_to_grid(/*with_heat=*/false);
     node_heat_ = heat;
-    node_T_ = temperature;
+    (*node_T_) = temperature;
   }
 }
 

@@ -96,7 +96,8 @@ class ThermalPhysics final : public Physics {
   // ---- grid ------------------------------------------------------------------------------------
   ColouredBlocks<kDim> blocks_;
   NodalHeat nodal_;
-  std::vector<double> node_volume_, node_heat_, node_T_, node_force_;
+  std::vector<double> node_volume_, node_heat_, node_force_;
+  std::vector<double>* node_T_ = nullptr;  ///< the kernel's node field 'temperature' (from initialize() on)
   std::vector<double> node_pending_;  ///< heat [J] shed by particles, joins node_heat_ next step
   std::vector<std::vector<double>> node_pore_heat_;  ///< G_m(T_i), per material
   std::vector<char> dirichlet_;

@@ -36,10 +36,11 @@ TEST_CASE("bench smoke test: throughput --quick prints the table with finite pos
                              "/bench/throughput --quick --sizes 30000 --threads 1,2"
                              " --repeat 1 --steps 3 --roofline-work 1e5 --frostmpm " + frostmpm_exe() +
                              " --roofline " + roofline_exe() + " --runs " + dir.file("runs") + " --out " +
-                             dir.file("table.csv"));
+                             dir.file("table.csv") + " --baseline " + frostmpm_exe());
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
   CHECK(r.output.find("scene p-s/s") != std::string::npos);
+  CHECK(r.output.find("vs base") != std::string::npos);
   CHECK(r.output.find("roofline") != std::string::npos);
 
   const CsvTable table = read_csv(dir.file("table.csv"));
@@ -52,7 +53,8 @@ TEST_CASE("bench smoke test: throughput --quick prints the table with finite pos
     CHECK(row[table.column("cells_y")] == 50);
     threads.insert(row[table.column("threads")]);
     for (const char* name : {"steps", "scene_ps_per_s", "scene_whole_run_ps_per_s", "scene_wall_s", "roofline_ps_per_s",
-                             "ratio", "scene_speedup", "roofline_speedup", "roofline_cpu_share"}) {
+                             "ratio", "scene_speedup", "roofline_speedup", "roofline_cpu_share", "baseline_ps_per_s",
+                             "vs_baseline"}) {
       const double value = row[table.column(name)];
       INFO(name << " = " << value);
       CHECK(std::isfinite(value));

@@ -373,7 +373,10 @@ class MemoryPhysics final : public Physics {
     sim.declare_state_field(field(), 1, 0.0);
     nodal_.assign(sim.grid().node_count(), 0.0);
   }
-  std::vector<Stage> stages() override { return {{name_ + ".update", [this] { update(); }}}; }
+  std::vector<Stage> stages() override {
+    return {{name_ + ".update", Phase::UpdateMaterials, {particle_field(field())}, {particle_field(field())},
+             [this] { update(); }}};
+  }
   void initialize() override {  // an initial condition a restart must overwrite
     auto v = sim_->particles().field(field());
     for (std::size_t p = 0; p < v.size(); ++p) v[p] = 1.0 + 1e-3 * double(p);
