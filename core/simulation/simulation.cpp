@@ -372,10 +372,18 @@ void Simulation::read_probes(const ConfigNode* node) {
   if (node) {
     static const std::vector<std::string> types = {"min", "max", "value_at", "integral", "isotherm"};
     const auto names = particles_.field_names();
+    // A scalar field, or one component of a vector field: "water_flux.y".
+    std::vector<std::string> scalars;
+    for (const auto& n : names) {
+      const int c = particles_.components(n);
+      if (c == 1) scalars.push_back(n);
+      else
+        for (int d = 0; d < std::min(c, 3); ++d) scalars.push_back(n + "." + "xyz"[d]);
+    }
     auto check_field = [&](const ConfigNode& f) {
       const std::string name = f.as_string();
-      if (!particles_.has(name) || particles_.components(name) != 1)
-        throw f.error("unknown scalar field '" + name + "'; available: " + join(names));
+      if (std::find(scalars.begin(), scalars.end(), name) == scalars.end())
+        throw f.error("unknown scalar field '" + name + "'; available: " + join(scalars));
       return name;
     };
     for (const auto& item : node->elements()) {
@@ -470,9 +478,19 @@ void Simulation::check_finite() const {
   }
 }
 
+Simulation::ScalarColumn Simulation::scalar_column(const std::string& name) const {
+  const auto dot = name.rfind('.');
+  if (dot != std::string::npos && !particles_.has(name)) {
+    const std::string base = name.substr(0, dot);
+    const std::size_t c = std::string("xyz").find(name.substr(dot + 1));
+    return {particles_.field(base), c, static_cast<std::size_t>(particles_.components(base))};
+  }
+  return {particles_.field(name), 0, 1};
+}
+
 double Simulation::sample_field(const std::string& field, const std::array<double, kDim>& point) const {
   // Volume-weighted nodal average of the particle field, then bilinear interpolation.
-  const auto values = particles_.field(field);
+  const auto [values, component, stride] = scalar_column(field);
   const auto vol = particles_.field("volume");
   const std::size_t K = static_cast<std::size_t>(stencil_.per_particle());
   std::array<int, kDim> base{};
@@ -496,7 +514,7 @@ double Simulation::sample_field(const std::string& field, const std::array<doubl
     for (std::size_t k = 0; k < K; ++k)
       for (int c = 0; c < 4; ++c)
         if (nodes[k] == corner[c]) {
-          num[c] += vol[p] * w[k] * values[p];
+          num[c] += vol[p] * w[k] * values[p * stride + component];
           den[c] += vol[p] * w[k];
         }
   }
@@ -514,16 +532,18 @@ std::vector<double> Simulation::evaluate_probes() const {
   const auto vol = particles_.field("volume");
   for (const auto& probe : probes_) {
     if (probe->type == "min" || probe->type == "max") {
-      const auto f = particles_.field(probe->field);
-      out.push_back(probe->type == "min" ? *std::min_element(f.begin(), f.end())
-                                         : *std::max_element(f.begin(), f.end()));
+      const auto [f, component, stride] = scalar_column(probe->field);
+      double extreme = f[component];
+      for (std::size_t i = component; i < f.size(); i += stride)
+        extreme = probe->type == "min" ? std::min(extreme, f[i]) : std::max(extreme, f[i]);
+      out.push_back(extreme);
     } else if (probe->type == "integral") {
       double sum = 0;
-      std::vector<std::span<const double>> cols;
-      for (const auto& name : probe->fields) cols.push_back(particles_.field(name));
+      std::vector<ScalarColumn> cols;
+      for (const auto& name : probe->fields) cols.push_back(scalar_column(name));
       for (std::size_t p = 0; p < particles_.size(); ++p) {
         double v = vol[p];
-        for (const auto& c : cols) v *= c[p];
+        for (const auto& c : cols) v *= c.values[p * c.stride + c.component];
         sum += v;
       }
       out.push_back(sum);

@@ -119,7 +119,8 @@ class Simulation {
 
   /// Advances one step of size dt (exposed for tests and benchmarks).
   void advance(double dt);
-  /// Value of a particle field interpolated to a point through the grid (volume-weighted).
+  /// Value of a particle field (a scalar, or a component "name.x") interpolated to a point
+  /// through the grid (volume-weighted).
   double sample_field(const std::string& field, const std::array<double, kDim>& point) const;
 
  private:
@@ -127,6 +128,13 @@ class Simulation {
   void update_stencil();
   struct Probe;
   struct RegionInit;
+  /// A scalar field or one component of a vector field ("water_flux.y"): value p is
+  /// values[p * stride + component].
+  struct ScalarColumn {
+    std::span<const double> values;
+    std::size_t component = 0, stride = 1;
+  };
+  ScalarColumn scalar_column(const std::string& name) const;
   const Registry& registry_;
   UniformGrid<kDim> grid_;
   ShapeKind shape_ = ShapeKind::Gimp;

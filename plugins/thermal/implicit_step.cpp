@@ -18,49 +18,18 @@
 namespace frostmpm::thermal {
 
 void ThermalPhysics::build_graph() {
-  const auto& st = sim_->stencil();
   const std::size_t nodes = node_volume_.size();
-  const int K = st.per_particle();
-  std::vector<std::vector<int>> columns(nodes);
-  for (std::size_t i = 0; i < nodes; ++i) columns[i].push_back(static_cast<int>(i));
-  for (std::size_t p = 0; p < st.particles(); ++p) {
-    const auto* n = st.nodes(p);
-    for (int a = 0; a < K; ++a)
-      for (int b = 0; b < K; ++b) columns[n[a]].push_back(static_cast<int>(n[b]));
-  }
-  offsets_.assign(nodes + 1, 0);
-  columns_.clear();
-  for (std::size_t i = 0; i < nodes; ++i) {
-    auto& c = columns[i];
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-    columns_.insert(columns_.end(), c.begin(), c.end());
-    offsets_[i + 1] = columns_.size();
-  }
-  auto position = [&](std::size_t row, int col) {
-    const auto begin = columns_.begin() + static_cast<long>(offsets_[row]);
-    const auto end = columns_.begin() + static_cast<long>(offsets_[row + 1]);
-    return static_cast<std::size_t>(std::lower_bound(begin, end, col) - columns_.begin());
-  };
-  scatter_.resize(st.particles() * K * K);
-  parallel_for(st.particles(), [&](std::size_t p) {
-    const auto* n = st.nodes(p);
-    for (int a = 0; a < K; ++a)
-      for (int b = 0; b < K; ++b) scatter_[(p * K + a) * K + b] = static_cast<int>(position(n[a], static_cast<int>(n[b])));
-  });
-  diagonal_.resize(nodes);
-  for (std::size_t i = 0; i < nodes; ++i) diagonal_[i] = position(i, static_cast<int>(i));
+  graph_.build(sim_->stencil(), nodes);
   SolverOptions options;
   options.method = "cg";
   options.preconditioner = params_.string("preconditioner");
   options.tolerance = params_.real("linear_tolerance");
   options.max_iterations = 5000;
-  system_ = std::make_unique<SparseSystem>(offsets_, columns_, options);
-  for (auto* v : {&stiffness_, &free_stiffness_, &matrix_values_}) v->assign(columns_.size(), 0.0);
+  system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
+  for (auto* v : {&stiffness_, &free_stiffness_, &matrix_values_}) v->assign(graph_.nonzeros(), 0.0);
   for (auto* v : {&boundary_diagonal_, &boundary_load_, &residual_, &rhs_, &increment_, &K_times_T_,
                   &K_times_increment_, &start_heat_, &start_T_, &node_T_before_})
     v->assign(nodes, 0.0);
-  graph_version_ = st.version();
   assembled_conductivity_.clear();  // a new graph is assembled in full
 }
 
@@ -86,7 +55,7 @@ void ThermalPhysics::assemble_conductivity() {
     }
   if (any) {
     parallel_for(node_volume_.size(), [&](std::size_t i) {
-      if (row_dirty_[i]) std::fill(stiffness_.begin() + long(offsets_[i]), stiffness_.begin() + long(offsets_[i + 1]), 0.0);
+      if (row_dirty_[i]) std::fill(stiffness_.begin() + long(graph_.offsets[i]), stiffness_.begin() + long(graph_.offsets[i + 1]), 0.0);
     });
     blocks_.for_each([&](std::size_t p) {
       const auto* nodes = st.nodes(p);
@@ -94,7 +63,7 @@ void ThermalPhysics::assemble_conductivity() {
       for (int k = 0; k < K; ++k) touches |= row_dirty_[nodes[k]] != 0;
       if (!touches) return;
       const auto* g = st.gradients(p);
-      const int* slot = scatter_.data() + p * K * K;
+      const int* slot = graph_.scatter.data() + p * K * K;
       const double a = vol[p] * conductivity_[p];
       for (int i = 0; i < K; ++i) {
         if (!row_dirty_[nodes[i]]) continue;
@@ -108,8 +77,8 @@ void ThermalPhysics::assemble_conductivity() {
   }
   parallel_for(node_volume_.size(), [&](std::size_t i) {
     const bool fixed_row = !is_free(i);
-    for (std::size_t e = offsets_[i]; e < offsets_[i + 1]; ++e) {
-      const auto j = static_cast<std::size_t>(columns_[e]);
+    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) {
+      const auto j = static_cast<std::size_t>(graph_.columns[e]);
       free_stiffness_[e] = fixed_row ? (i == j ? 1.0 : 0.0) : is_free(j) ? stiffness_[e] : 0.0;
     }
   });
@@ -118,7 +87,7 @@ void ThermalPhysics::assemble_conductivity() {
 void ThermalPhysics::multiply_conductivity(const std::vector<double>& x, std::vector<double>& y) const {
   parallel_for(y.size(), [&](std::size_t i) {
     double s = 0;
-    for (std::size_t e = offsets_[i]; e < offsets_[i + 1]; ++e) s += stiffness_[e] * x[static_cast<std::size_t>(columns_[e])];
+    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) s += stiffness_[e] * x[static_cast<std::size_t>(graph_.columns[e])];
     y[i] = s;
   });
 }
@@ -223,7 +192,7 @@ bool ThermalPhysics::newton(double t_end, double h) {
       rhs_[i] = -residual_[i];
       increment_[i] = 0.0;
       if (is_free(i))
-        matrix_values_[diagonal_[i]] += node_volume_[i] * nodal_.capacity(i, (*node_T_)[i]) / h + boundary_diagonal_[i];
+        matrix_values_[graph_.diagonal[i]] += node_volume_[i] * nodal_.capacity(i, (*node_T_)[i]) / h + boundary_diagonal_[i];
     });
     system_->set_values(matrix_values_);
     // The preconditioner is built once per step, from the step's first tangent, and reused by the
@@ -252,7 +221,7 @@ bool ThermalPhysics::newton(double t_end, double h) {
 
 void ThermalPhysics::solve_implicit() {
   const auto& st = sim_->stencil();
-  if (!system_ || st.version() != graph_version_) build_graph();
+  if (!system_ || st.version() != graph_.stencil_version) build_graph();
   assemble_conductivity();
   preconditioner_fresh_ = false;  // the tangent's off-diagonal part changed with κ
   const std::size_t nodes = (*node_T_).size();

@@ -29,6 +29,7 @@
 #include "frostmpm/scene/time_function.hpp"
 #include "frostmpm/simulation/simulation.hpp"
 #include "frostmpm/transfer/coloured_blocks.hpp"
+#include "frostmpm/transfer/stencil_graph.hpp"
 #include "mixture_properties.hpp"
 #include "nodal_heat.hpp"
 
@@ -107,14 +108,10 @@ class ThermalPhysics final : public Physics {
 
   // ---- implicit --------------------------------------------------------------------------------
   std::unique_ptr<SparseSystem> system_;
-  std::vector<std::size_t> offsets_;  ///< CSR pattern of the conductivity matrix
-  std::vector<int> columns_;
-  std::vector<int> scatter_;           ///< CSR position of every (particle, k1, k2) pair
-  std::vector<std::size_t> diagonal_;  ///< CSR position of (i, i)
+  StencilGraph graph_;  ///< CSR pattern of the conductivity matrix
   std::vector<double> stiffness_, free_stiffness_, matrix_values_;
   std::vector<double> boundary_diagonal_, boundary_load_;  ///< h A_i and q A_i + h A_i T_a
   std::vector<double> residual_, rhs_, increment_, K_times_T_, K_times_increment_, start_heat_, start_T_;
-  std::uint64_t graph_version_ = 0;
   std::vector<double> assembled_conductivity_;  ///< κ_p as in stiffness_
   std::vector<char> row_dirty_;
   long halvings_ = 0;  ///< the last step's substep level (the next step starts one coarser)

@@ -1,0 +1,48 @@
+#include "frostmpm/transfer/stencil_graph.hpp"
+
+#include <algorithm>
+
+#include "frostmpm/parallel/parallel.hpp"
+
+namespace frostmpm {
+
+std::size_t StencilGraph::position(std::size_t row, int col) const {
+  const auto begin = columns.begin() + static_cast<long>(offsets[row]);
+  const auto end = columns.begin() + static_cast<long>(offsets[row + 1]);
+  return static_cast<std::size_t>(std::lower_bound(begin, end, col) - columns.begin());
+}
+
+template <int Dim>
+void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes) {
+  const int K = st.per_particle();
+  std::vector<std::vector<int>> rows(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) rows[i].push_back(static_cast<int>(i));
+  for (std::size_t p = 0; p < st.particles(); ++p) {
+    const auto* n = st.nodes(p);
+    for (int a = 0; a < K; ++a)
+      for (int b = 0; b < K; ++b) rows[n[a]].push_back(static_cast<int>(n[b]));
+  }
+  offsets.assign(nodes + 1, 0);
+  columns.clear();
+  for (std::size_t i = 0; i < nodes; ++i) {
+    auto& c = rows[i];
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    columns.insert(columns.end(), c.begin(), c.end());
+    offsets[i + 1] = columns.size();
+  }
+  scatter.resize(st.particles() * K * K);
+  parallel_for(st.particles(), [&](std::size_t p) {
+    const auto* n = st.nodes(p);
+    for (int a = 0; a < K; ++a)
+      for (int b = 0; b < K; ++b) scatter[(p * K + a) * K + b] = static_cast<int>(position(n[a], static_cast<int>(n[b])));
+  });
+  diagonal.resize(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) diagonal[i] = position(i, static_cast<int>(i));
+  stencil_version = st.version();
+}
+
+template void StencilGraph::build<2>(const StencilCache<2>&, std::size_t);
+template void StencilGraph::build<3>(const StencilCache<3>&, std::size_t);
+
+}  // namespace frostmpm

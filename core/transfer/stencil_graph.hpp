@@ -1,0 +1,31 @@
+#pragma once
+// The sparsity graph of a nodal operator assembled from particles (Σ_p V_p f_p ∇S_ip·∇S_jp
+// and the like): node i couples to node j when some particle's stencil holds both. Built
+// once per stencil topology and kept while particles stand still, so an implicit physics
+// reassembles values into a fixed CSR pattern (and SparseSystem keeps its graph and
+// preconditioner structure).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "frostmpm/shape/stencil_cache.hpp"
+
+namespace frostmpm {
+
+struct StencilGraph {
+  std::vector<std::size_t> offsets;  ///< CSR row offsets (nodes + 1)
+  std::vector<int> columns;          ///< sorted column indices of each row
+  std::vector<int> scatter;          ///< CSR position of (particle p, stencil slot a, slot b)
+  std::vector<std::size_t> diagonal; ///< CSR position of (i, i); every node has one
+  std::uint64_t stencil_version = 0; ///< the stencil it was built for
+
+  /// Builds the graph of `nodes` nodes from the stencil's particles.
+  template <int Dim>
+  void build(const StencilCache<Dim>& stencil, std::size_t nodes);
+  std::size_t rows() const { return offsets.empty() ? 0 : offsets.size() - 1; }
+  std::size_t nonzeros() const { return columns.size(); }
+  /// CSR position of (row, col), which must be in the pattern.
+  std::size_t position(std::size_t row, int col) const;
+};
+
+}  // namespace frostmpm

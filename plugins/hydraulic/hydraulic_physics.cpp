@@ -1,0 +1,329 @@
+#include "hydraulic_physics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "frostmpm/parallel/parallel.hpp"
+#include "frostmpm/plugin/plugin_api.hpp"
+
+namespace frostmpm::hydraulic {
+
+ParamSchema HydraulicPhysics::schema() {
+  ParamSchema s;
+  s.reals("gravity", "m/s^2", "body force on the pore water, e.g. [0, -9.81]; [0, 0] makes pressure the excess "
+                              "(non-hydrostatic) pressure, as in the INTERFROST cases")
+      .size(kDim)
+      .defaults_to(std::vector<double>(kDim, 0.0));
+  s.real("reference_gravity", "m/s^2", "g in the drag n_l² ρ_l g / (K k_r): the gravity the hydraulic conductivity K "
+                                       "[m/s] is defined with (not the body force)")
+      .defaults_to(9.81)
+      .above(0);
+  s.choice("preconditioner", {"none", "jacobi", "ilu", "multigrid"}, "preconditioner of the CG pressure solve")
+      .defaults_to("multigrid");
+  s.real("linear_tolerance", "-", "relative residual of the pressure solve").defaults_to(1e-10).above(0).below(1);
+  s.integer("max_linear_iterations", "CG iterations per pressure solve before the run stops")
+      .defaults_to(2000L)
+      .at_least(1);
+  return s;
+}
+
+HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
+  for (int d = 0; d < kDim; ++d) gravity_[d] = p.reals("gravity")[d];
+  reference_gravity_ = p.real("reference_gravity");
+}
+
+ParamSchema HydraulicPhysics::material_schema() const {
+  ParamSchema s;
+  // The same specs as the thermal physics' (a key two physics read is validated once).
+  s.real("porosity", "-", "porosity φ (pore space filled by water and ice)").above(0).below(1);
+  s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0);
+  s.real("water_compressibility", "1/Pa", "compressibility of pore water c_w = 1/K_l (INTERFROST: 1e-8)")
+      .defaults_to(4.6e-10)
+      .at_least(0);
+  return s;
+}
+
+void HydraulicPhysics::setup(Simulation& sim) {
+  sim_ = &sim;
+  auto& particles = sim.particles();
+  sim.declare_state_field("porosity", 1, 0.0);
+  sim.declare_state_field("pore_pressure", 1, 0.0);
+  particles.declare("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
+  particles.declare("liquid_velocity", kDim, 0.0);
+  particles.declare("water_flux", kDim, 0.0);
+  particles.declare("liquid_velocity_predicted", kDim, 0.0);
+
+  bool compressible = false;
+  for (const auto& m : sim.materials()) {
+    MaterialModels models;
+    models.absolute = m.models.at("absolute_permeability").create<AbsolutePermeabilityModel>(sim.registry());
+    if (m.models.count("relative_permeability"))
+      models.relative = m.models.at("relative_permeability").create<RelativePermeabilityModel>(sim.registry());
+    models.water_density = m.params.real("water_density");
+    models.compressibility = m.params.real("water_compressibility");
+    compressible = compressible || models.compressibility > 0;
+    materials_.push_back(std::move(models));
+  }
+  auto phi = particles.field("porosity");
+  material_.resize(particles.size());
+  for (const auto& r : particles.ranges()) {
+    std::fill(phi.begin() + r.begin, phi.begin() + r.end, sim.materials()[r.material].params.real("porosity"));
+    std::fill(material_.begin() + r.begin, material_.begin() + r.end, static_cast<std::uint16_t>(r.material));
+  }
+  read_boundaries(sim);
+  if (!compressible && pressure_bcs_.empty())
+    throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
+                     "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
+
+  const std::size_t n = particles.size(), nodes = sim.grid().node_count();
+  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_}) v->assign(n, 0.0);
+  for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
+}
+
+void HydraulicPhysics::read_boundaries(Simulation& sim) {
+  auto label = [](const BoundaryCondition* bc) { return bc->type + " condition on " + bc->target_text; };
+  for (auto* bc : sim.boundary_conditions("pore_pressure")) {
+    if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
+    PressureCondition c;
+    c.nodes = bc->nodes;
+    c.value = TimeFunction::read(bc->node->child("value"));
+    if (auto h = bc->node->optional_child("hydrostatic")) c.hydrostatic = h->as_bool();
+    c.label = label(bc);
+    pressure_bcs_.push_back(std::move(c));
+  }
+  for (auto* bc : sim.boundary_conditions("water_flux")) {
+    const bool face = !bc->on_particles &&
+                      std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
+    if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");
+    flux_bcs_.push_back({bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value")), label(bc)});
+  }
+}
+
+double HydraulicPhysics::pressure_value(const PressureCondition& c, std::size_t node, double t) const {
+  double v = c.value(t);
+  const auto x = sim_->grid().node_position(node);
+  if (c.hydrostatic) {  // value = water-table elevation: p = ρ_l g (h − y)
+    double rho = materials_.empty() ? 1000.0 : materials_[0].water_density;
+    v = rho * reference_gravity_ * (v - x[kDim - 1]);
+  }
+  if (std::isfinite(v)) return v;
+  std::ostringstream msg;
+  msg << "numerical blow-up: pore pressure boundary value " << v << " from the " << c.label << " (x = " << x[0]
+      << ", y = " << x[1] << ") at t = " << t << " s, step " << sim_->step() << "; check the value's table or expression";
+  throw NumericalBlowUp(msg.str());
+}
+
+std::vector<Stage> HydraulicPhysics::stages() {
+  const auto x = particle_field("position", kDim), vol = particle_field("volume"), phi = particle_field("porosity"),
+             S = particle_field("liquid_saturation"), p = particle_field("pore_pressure"),
+             v = particle_field("liquid_velocity", kDim), v_star = particle_field("liquid_velocity_predicted", kDim),
+             q = particle_field("water_flux", kDim);
+  // The nodal pressure is the state while particles stand still: carried between steps.
+  const auto p_node = carried_node_field("pore_pressure"), v_node = node_field("liquid_velocity", kDim),
+             dp = node_field("pressure_increment");
+  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, v}, {p_node, v_node},
+           [this] { map_to_grid(); }},
+          {"hydraulic.predict", Phase::PredictMomentum, {p_node, v}, {v_star}, [this] { predict(); }},
+          {"hydraulic.pressure", Phase::Pressure, {v_star, p_node}, {dp}, [this] { solve_pressure(); }},
+          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, dp, p_node}, {v, q, p_node}, [this] { correct(); }},
+          {"hydraulic.map_to_particles", Phase::MapToParticles, {p_node}, {p}, [this] { map_to_particles(); }}};
+}
+
+void HydraulicPhysics::initialize() {
+  auto& nf = sim_->node_fields();
+  p_ = &nf.values("pore_pressure");
+  v_ = &nf.values("liquid_velocity");
+  dp_ = &nf.values("pressure_increment");
+  time_ = sim_->time();
+  update_coefficients();
+  project_to_grid();
+}
+
+void HydraulicPhysics::begin_step(double time, double dt) {
+  time_ = time;
+  dt_ = dt;
+}
+
+// ---- coefficients and the grid state -----------------------------------------------------------
+
+/// n_l = φ S_l, C_d = n_l² ρ_l g / (K k_r), ξ, η and the storage n_l c_w of every particle.
+void HydraulicPhysics::update_coefficients() {
+  auto& particles = sim_->particles();
+  const auto phi = particles.field("porosity");
+  const auto S = particles.field("liquid_saturation");
+  for (const auto& r : particles.ranges()) {
+    const auto& m = materials_[r.material];
+    const std::span<const double> phi_r(phi.data() + r.begin, r.size()), S_r(S.data() + r.begin, r.size());
+    m.absolute->evaluate(phi_r, std::span<double>(k_a_.data() + r.begin, r.size()),
+                         std::span<double>(scratch_.data() + r.begin, r.size()));
+    if (m.relative)
+      m.relative->evaluate(S_r, phi_r, std::span<double>(k_r_.data() + r.begin, r.size()),
+                           std::span<double>(scratch_.data() + r.begin, r.size()));
+    else
+      std::fill(k_r_.begin() + r.begin, k_r_.begin() + r.end, 1.0);
+  }
+  parallel_for(particles.size(), [&](std::size_t p) {
+    const auto& m = materials_[material_[p]];
+    const double rho = m.water_density;
+    n_l_[p] = phi[p] * std::clamp(S[p], 0.0, 1.0);
+    const double conductivity = std::max(k_a_[p] * k_r_[p], 1e-300);
+    drag_[p] = n_l_[p] * n_l_[p] * rho * reference_gravity_ / conductivity;
+    const double inertia = n_l_[p] * rho;
+    xi_[p] = inertia > 0 ? inertia / (inertia + dt_ * drag_[p]) : 0.0;
+    // η = ξ n_l / ρ_l = n_l² / (n_l ρ_l + Δt C_d), written so that Δt → 0 stays finite.
+    eta_[p] = inertia > 0 ? n_l_[p] * n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
+    storage_[p] = n_l_[p] * m.compressibility;
+  });
+}
+
+/// P2G of the particles' pressure (volume-weighted): the nodal state at the start, and
+/// whenever particles have moved.
+void HydraulicPhysics::project_to_grid() {
+  const auto& st = sim_->stencil();
+  auto& particles = sim_->particles();
+  if (blocks_.particles() != particles.size() || blocks_.stencil_version() != st.version())
+    blocks_.build(sim_->grid(), st, support_width(st.kind()));
+  const auto vol = particles.field("volume");
+  const auto p = particles.field("pore_pressure");
+  std::vector<double> weight(p_->size(), 0.0);
+  std::fill(p_->begin(), p_->end(), 0.0);
+  const int K = st.per_particle();
+  blocks_.for_each([&](std::size_t q) {
+    const auto* nodes = st.nodes(q);
+    const auto* w = st.weights(q);
+    for (int k = 0; k < K; ++k) {
+      weight[nodes[k]] += w[k] * vol[q];
+      (*p_)[nodes[k]] += w[k] * vol[q] * p[q];
+    }
+  });
+  parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] = weight[i] > 0 ? (*p_)[i] / weight[i] : 0.0; });
+  for (const auto& bc : pressure_bcs_)
+    for (std::size_t i : bc.nodes) (*p_)[i] = pressure_value(bc, i, time_);
+  projected_version_ = st.version();
+  grid_valid_ = true;
+}
+
+void HydraulicPhysics::map_to_grid() {
+  update_coefficients();
+  const auto& st = sim_->stencil();
+  if (!grid_valid_ || st.version() != projected_version_) project_to_grid();
+  // The nodal liquid velocity of the step's start (liquid-mass-weighted), for whoever reads it
+  // (the convective heat term); the liquid mass also marks the nodes the pressure lives on.
+  const auto vol = sim_->particles().field("volume");
+  const auto v = sim_->particles().field("liquid_velocity");
+  std::fill(node_mass_.begin(), node_mass_.end(), 0.0);
+  std::fill(v_->begin(), v_->end(), 0.0);
+  const int K = st.per_particle();
+  blocks_.for_each([&](std::size_t q) {
+    const auto* nodes = st.nodes(q);
+    const auto* w = st.weights(q);
+    const double m = vol[q] * n_l_[q] * materials_[material_[q]].water_density;
+    for (int k = 0; k < K; ++k) {
+      node_mass_[nodes[k]] += w[k] * m;
+      for (int d = 0; d < kDim; ++d) (*v_)[nodes[k] * kDim + d] += w[k] * m * v[q * kDim + d];
+    }
+  });
+  parallel_for(node_mass_.size(), [&](std::size_t i) {
+    for (int d = 0; d < kDim; ++d) (*v_)[i * kDim + d] = node_mass_[i] > 0 ? (*v_)[i * kDim + d] / node_mass_[i] : 0.0;
+  });
+  // Boundary pressures at the step's start (a time function moves them between steps).
+  for (const auto& bc : pressure_bcs_)
+    for (std::size_t i : bc.nodes) (*p_)[i] = pressure_value(bc, i, time_);
+}
+
+/// At every particle, v* = (n_l ρ_l v + Δt (−n_l ∇p(x_p) + n_l ρ_l b)) / (n_l ρ_l + Δt C_d):
+/// the liquid momentum with implicit drag and the pressure of the step's start (Eq. 43 with the
+/// gradient form of Eq. 14), at the material points (docs/architecture.md: why there).
+void HydraulicPhysics::predict() {
+  const auto& st = sim_->stencil();
+  auto& particles = sim_->particles();
+  const auto v = particles.field("liquid_velocity");
+  auto v_star = particles.field("liquid_velocity_predicted");
+  const int K = st.per_particle();
+  parallel_for(particles.size(), [&](std::size_t q) {
+    const auto* nodes = st.nodes(q);
+    const auto* g = st.gradients(q);
+    std::array<double, kDim> grad{};
+    for (int k = 0; k < K; ++k)
+      for (int d = 0; d < kDim; ++d) grad[d] += g[k * kDim + d] * (*p_)[nodes[k]];
+    const double inertia = n_l_[q] * materials_[material_[q]].water_density, denominator = inertia + dt_ * drag_[q];
+    for (int d = 0; d < kDim; ++d)
+      v_star[q * kDim + d] = denominator > 0 ? (inertia * (v[q * kDim + d] + dt_ * gravity_[d]) -
+                                                dt_ * n_l_[q] * grad[d]) / denominator
+                                             : 0.0;
+  });
+}
+
+/// v = v* − Δt (ξ / ρ_l) ∇Δp(x_p) at every particle (Eq. 47); p_i += Δp_i. The pressure solve
+/// made Σ_p V_p n_l ∇S_ip · v_p balance storage and boundary inflow exactly.
+void HydraulicPhysics::correct() {
+  const auto& st = sim_->stencil();
+  auto& particles = sim_->particles();
+  const auto v_star = particles.field("liquid_velocity_predicted");
+  auto v = particles.field("liquid_velocity");
+  auto flux = particles.field("water_flux");
+  const int K = st.per_particle();
+  parallel_for(particles.size(), [&](std::size_t q) {
+    const auto* nodes = st.nodes(q);
+    const auto* g = st.gradients(q);
+    std::array<double, kDim> grad{};
+    for (int k = 0; k < K; ++k)
+      for (int d = 0; d < kDim; ++d) grad[d] += g[k * kDim + d] * (*dp_)[nodes[k]];
+    const double a = dt_ * xi_[q] / materials_[material_[q]].water_density;
+    for (int d = 0; d < kDim; ++d) {
+      v[q * kDim + d] = v_star[q * kDim + d] - a * grad[d];
+      flux[q * kDim + d] = n_l_[q] * v[q * kDim + d];
+    }
+  });
+  parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
+}
+
+/// Particle pressure from the nodes (the grid holds the state while particles stand still).
+void HydraulicPhysics::map_to_particles() {
+  const auto& st = sim_->stencil();
+  auto p = sim_->particles().field("pore_pressure");
+  const int K = st.per_particle();
+  parallel_for(p.size(), [&](std::size_t a) {
+    const auto* nodes = st.nodes(a);
+    const auto* w = st.weights(a);
+    double pressure = 0;
+    for (int k = 0; k < K; ++k) pressure += w[k] * (*p_)[nodes[k]];
+    p[a] = pressure;
+  });
+}
+
+// ---- checkpoints and counters ----------------------------------------------------------------------
+
+std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
+  saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
+  return {{"scalars", &saved_scalars_}};
+}
+
+void HydraulicPhysics::restored() {
+  const auto& s = saved_scalars_;
+  if (s.size() != 4) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 4");
+  solves_ = long(s[0]);
+  iterations_total_ = long(s[1]);
+  iterations_max_ = long(s[2]);
+  residual_max_ = s[3];
+  // The nodal state came back with the kernel's carried node fields; it belongs to this stencil.
+  projected_version_ = sim_->stencil().version();
+  grid_valid_ = true;
+}
+
+std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const {
+  return {{"hydraulic.pressure_solves", double(solves_)},
+          {"hydraulic.linear_iterations_total", double(iterations_total_)},
+          {"hydraulic.linear_iterations_max", double(iterations_max_)},
+          {"hydraulic.linear_iterations_mean", solves_ ? double(iterations_total_) / double(solves_) : 0.0},
+          {"hydraulic.relative_residual_max", residual_max_},
+          {"hydraulic.solve_seconds", solve_seconds_}};
+}
+
+FROSTMPM_REGISTER(Physics, HydraulicPhysics)
+
+}  // namespace frostmpm::hydraulic
+
+FROSTMPM_PLUGIN("frostmpm-hydraulic", "0.1.0")

@@ -1,0 +1,124 @@
+#pragma once
+// Pore-water flow through a fixed solid skeleton (paper Sec. 2.2–2.3, 4.1–4.3, Eqs. 14, 43–48,
+// 53–57, 61–63), by the fractional-step (pressure projection) method. Theory-to-code map:
+// docs/theory.md; design decisions: docs/architecture.md.
+//
+// Fixed solid (v_s ≡ 0, the paper's thermo-hydraulic examples): the corrector gives
+// ξ = n_l ρ_l / (n_l ρ_l + Δt C_d), η = ξ n_l / ρ_l, the ρ_s → ∞ limit of Eqs. 46 and 49, with
+// the drag coefficient C_d = n_l² ρ_l g_ref / (K k_r) (K the hydraulic conductivity, g_ref the
+// gravity it is defined with). Per step:
+//   map_to_grid   per-particle coefficients; the nodal pressure is carried between steps while
+//                 particles stand still (re-projected from the particles when they move); the
+//                 nodal liquid velocity of the step's start, for other physics;
+//   predict       at every material point v* = (n_l ρ_l (v + Δt b) − Δt n_l ∇p(x_p)) /
+//                 (n_l ρ_l + Δt C_d) (Eq. 43 with the gradient form of the pressure force, Eq. 14);
+//   pressure      (M/Δt + K) Δp = Σ_p V_p n_l ∇S_ip · v*_p + ∫ S_i q̂ dS, M lumped
+//                 Σ_p V_p n_l c_w S_ip, K = Σ_p V_p Δt η ∇S_ip·∇S_jp (Eq. 56), Δp prescribed on
+//                 pressure boundaries; CG through SparseSystem, the graph kept while the
+//                 stencil is unchanged, the preconditioner refreshed only when values change;
+//   correct       v_p = v*_p − Δt (ξ_p / ρ_l) ∇Δp(x_p) (Eq. 47), q_p = n_l v_p; p_i += Δp_i;
+//   map_to_particles  particle pressure interpolated from the nodes.
+// The momentum steps run at the material points, the quadrature points of the pressure
+// equation, so K is exactly the operator the corrector applies: mass balances in every step
+// (docs/architecture.md, "Pore-water flow").
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "frostmpm/linalg/sparse_system.hpp"
+#include "frostmpm/models/permeability_model.hpp"
+#include "frostmpm/physics/physics.hpp"
+#include "frostmpm/scene/time_function.hpp"
+#include "frostmpm/simulation/simulation.hpp"
+#include "frostmpm/transfer/coloured_blocks.hpp"
+#include "frostmpm/transfer/stencil_graph.hpp"
+
+namespace frostmpm::hydraulic {
+
+class HydraulicPhysics final : public Physics {
+ public:
+  static constexpr const char* kName = "hydraulic";
+  static constexpr const char* kDoc = "pore-water flow through a fixed skeleton (fractional-step pressure projection)";
+
+  static ParamSchema schema();
+  explicit HydraulicPhysics(const ParamSet& p);
+
+  ParamSchema material_schema() const override;
+  std::vector<ModelSlot> material_models() const override {
+    return {{"absolute_permeability", AbsolutePermeabilityModel::kKind, true},
+            {"relative_permeability", RelativePermeabilityModel::kKind, false}};
+  }
+  std::vector<std::string> boundary_types() const override { return {"pore_pressure", "water_flux"}; }
+
+  void setup(Simulation& sim) override;
+  std::vector<Stage> stages() override;
+  void initialize() override;
+  void begin_step(double time, double dt) override;
+  std::vector<PersistentArray> persistent_state() override;
+  void restored() override;
+  std::vector<std::pair<std::string, double>> statistics() const override;
+
+ private:
+  struct PressureCondition {
+    std::vector<std::size_t> nodes;
+    TimeFunction value;     ///< pressure [Pa], or the water-table elevation [m] when hydrostatic
+    bool hydrostatic = false;
+    std::string label;
+  };
+  struct FluxCondition {
+    std::vector<std::size_t> nodes;
+    std::vector<double> areas;
+    TimeFunction value;  ///< inflow Darcy flux [m/s]
+    std::string label;
+  };
+  struct MaterialModels {
+    std::shared_ptr<AbsolutePermeabilityModel> absolute;
+    std::shared_ptr<RelativePermeabilityModel> relative;  ///< none: k_r = 1
+    double water_density = 1000, compressibility = 0;
+  };
+
+  // ---- configuration
+  ParamSet params_;
+  Simulation* sim_ = nullptr;
+  std::array<double, kDim> gravity_{};
+  double reference_gravity_ = 9.81;
+  std::vector<MaterialModels> materials_;
+  std::vector<PressureCondition> pressure_bcs_;
+  std::vector<FluxCondition> flux_bcs_;
+
+  // ---- particles: per-step coefficients
+  std::vector<std::uint16_t> material_;
+  std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
+
+  // ---- grid (the kernel's node fields pore_pressure, liquid_velocity, pressure_increment) and the
+  // lumped liquid mass (a node no wet particle touches has none and no pressure unknown)
+  std::vector<double>*p_ = nullptr, *v_ = nullptr, *dp_ = nullptr;
+  std::vector<double> node_mass_, rhs_;
+  ColouredBlocks<kDim> blocks_;
+  std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
+  bool grid_valid_ = false;
+
+  // ---- pressure system
+  StencilGraph graph_;
+  std::unique_ptr<SparseSystem> system_;
+  std::vector<double> values_, assembled_values_;
+
+  // ---- step and counters
+  double time_ = 0, dt_ = 0;
+  long solves_ = 0, iterations_total_ = 0, iterations_max_ = 0;
+  double residual_max_ = 0, solve_seconds_ = 0;
+  std::vector<double> saved_scalars_;
+
+  void read_boundaries(Simulation& sim);
+  double pressure_value(const PressureCondition& c, std::size_t node, double t) const;
+  void update_coefficients();
+  void project_to_grid();
+  void map_to_grid();
+  void predict();
+  void solve_pressure();
+  void correct();
+  void map_to_particles();
+  void assemble();
+};
+
+}  // namespace frostmpm::hydraulic

@@ -1,0 +1,118 @@
+// Pore-water flow (plugins/hydraulic) against closed forms: steady Darcy flow in a column
+// (linear pressure, exact flux), a hydrostatic column at rest, and pressure diffusion in a
+// column against Terzaghi's series (VERIFICATION §2.1; fixed skeleton, compressible water).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+using namespace frostmpm::test;
+
+namespace {
+
+/// Runs configs/verification/<scene> on a 1 × cells column of height 1 m with extra overrides.
+CsvTable run_column(const TempDir& dir, const std::string& scene, int cells, const std::vector<std::string>& sets,
+                    const std::string& name) {
+  const double h = 1.0 / cells;
+  std::ostringstream cmd;
+  cmd.precision(17);
+  cmd << "run " << source_dir() << "/configs/verification/" << scene << " -o " << dir.file(name)
+      << " --set 'grid.cells=[1," << cells << "]' --set grid.cell_size=" << h
+      << " --set 'regions.0.shape={box: {min: [0, 0], max: [" << h << ", 1]}}' --set output.progress=false";
+  for (const auto& s : sets) cmd << " --set '" << s << "'";
+  const auto r = run_frostmpm(cmd.str());
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  return read_csv(dir.file(name + "/metrics.csv"));
+}
+
+/// u/u0 = Σ (2/M) sin(M z/H) exp(−M² T_v), M = π(2m+1)/2, z from the drained top (H = 1).
+double terzaghi(double z, double Tv) {
+  double sum = 0;
+  for (int m = 0; m < 400; ++m) {
+    const double M = M_PI * (2 * m + 1) / 2;
+    sum += 2 / M * std::sin(M * z) * std::exp(-M * M * Tv);
+  }
+  return sum;
+}
+
+}  // namespace
+
+TEST_CASE("steady Darcy flow in a column: linear pressure and the exact flux at two resolutions",
+          "[verification][hydraulic]") {
+  TempDir dir;
+  // K = 1e-5 m/s, 1 m head over 1 m: q = 1e-5 m/s upwards; p(0.5) = 4905 Pa; the first particle
+  // row (y = h/4) holds 9810 (1 − h/4).
+  for (int cells : {10, 40}) {
+    INFO(cells << " cells");
+    const auto t = run_column(dir, "darcy_column.yaml", cells, {}, "darcy" + std::to_string(cells));
+    const auto& last = t.rows.back();
+    CHECK(last[t.column("q_min")] == Approx(1e-5).epsilon(1e-7));
+    CHECK(last[t.column("q_max")] == Approx(1e-5).epsilon(1e-7));
+    CHECK(last[t.column("p_mid")] == Approx(4905.0).epsilon(1e-8));
+    CHECK(last[t.column("p_max")] == Approx(9810.0 * (1 - 0.25 / cells)).epsilon(1e-8));
+  }
+}
+
+TEST_CASE("a hydrostatic column stays at rest: gravity against a hydrostatic boundary", "[verification][hydraulic]") {
+  TempDir dir;
+  // Gravity on, the top held hydrostatic with the water table at y = 1 m, the base closed,
+  // the column starting at p = 0: it fills to p = ρ g (1 − y) and the flux dies out.
+  const auto t = run_column(dir, "darcy_column.yaml", 20,
+                            {"boundary_conditions=[{type: pore_pressure, nodes: {face: y_max}, value: 1.0, "
+                             "hydrostatic: true}]",
+                             "physics.hydraulic.gravity=[0, -9.81]"},
+                            "hydrostatic");
+  const auto& last = t.rows.back();
+  CHECK(last[t.column("p_mid")] == Approx(4905.0).epsilon(1e-8));
+  CHECK(last[t.column("p_max")] == Approx(9810.0 * (1 - 0.25 / 20)).epsilon(1e-8));
+  CHECK(std::abs(last[t.column("q_min")]) < 1e-12);
+  CHECK(std::abs(last[t.column("q_max")]) < 1e-12);
+}
+
+TEST_CASE("pressure diffusion in a column matches Terzaghi's isochrones, second order in h (dt ∝ h²)",
+          "[verification][hydraulic]") {
+  TempDir dir;
+  const double cv = 1e-6 / (0.4 * 1e-8 * 1000 * 9.81);  // K / (n c_w ρ g) = 0.025484 m²/s
+  const double t05 = 0.05 / cv;                           // metrics rows at T_v = 0.05 k
+  const std::vector<double> times = {0.05, 0.2, 0.5};
+  std::vector<std::vector<double>> error(3);  // [resolution][isochrone]: relative L2 over 20 heights
+  const std::vector<int> resolutions = {10, 20, 40};
+  for (std::size_t r = 0; r < resolutions.size(); ++r) {
+    const int cells = resolutions[r];
+    const double h = 1.0 / cells, dt = 0.098115 * (h / 0.05) * (h / 0.05);  // c_v Δt / h² = 1
+    std::ostringstream every, end, step;
+    every.precision(17);
+    end.precision(17);
+    step.precision(17);
+    every << "output.metrics_every=" << t05;
+    end << "time.end=" << 10 * t05;
+    step << "time.dt=" << dt;
+    const auto t = run_column(dir, "terzaghi_column.yaml", cells, {every.str(), end.str(), step.str()},
+                              "terzaghi" + std::to_string(cells));
+    for (double Tv : times) {
+      const auto& row = t.rows.at(static_cast<std::size_t>(std::lround(Tv / 0.05)));
+      REQUIRE(cv * row[t.column("time_s")] == Approx(Tv).epsilon(1e-9));
+      double e2 = 0, u2 = 0;
+      for (int k = 0; k < 20; ++k) {
+        const double y = 0.025 + 0.05 * k;
+        char name[16];
+        std::snprintf(name, sizeof name, "p_y%02d", k);
+        const double exact = terzaghi(1 - y, Tv), computed = row[t.column(name)] / 1e4;
+        e2 += (computed - exact) * (computed - exact);
+        u2 += exact * exact;
+      }
+      error[r].push_back(std::sqrt(e2 / u2));
+    }
+  }
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    INFO("T_v = " << times[i] << ": relative L2 errors " << error[0][i] << ", " << error[1][i] << ", " << error[2][i]);
+    CHECK(error[2][i] < 0.005);  // measured 0.09 %, 0.02 %, 0.07 %; the issue asks ≤ 2 %
+    for (std::size_t r = 0; r + 1 < resolutions.size(); ++r) CHECK(std::log2(error[r][i] / error[r + 1][i]) > 1.5);
+    CHECK(std::log2(error[0][i] / error[2][i]) / 2 > 1.8);  // measured 1.8–2.3 pairwise, 2.0–2.5 overall
+  }
+}
