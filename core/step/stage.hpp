@@ -37,6 +37,9 @@ struct FieldRef {
   /// For a nodal field a stage writes: its value is kept from one step to the next, so a
   /// stage that runs before the writer reads the last step's value (and checkpoints keep it).
   bool carried = false;
+  /// For a read: used when the scene provides it, dropped from the step otherwise (e.g. the
+  /// thermal physics' convective term reads the Darcy flux only when some physics writes it).
+  bool optional = false;
 
   std::string describe() const;  ///< "particle field 'temperature'", "node field 'liquid_velocity'"
   bool same_field(const FieldRef& other) const { return location == other.location && name == other.name; }
@@ -47,6 +50,11 @@ inline FieldRef particle_field(std::string name, int components = 1) {
 }
 inline FieldRef node_field(std::string name, int components = 1) {
   return {FieldLocation::Node, std::move(name), components, false};
+}
+/// A read the stage can do without (see FieldRef::optional).
+inline FieldRef optional_read(FieldRef f) {
+  f.optional = true;
+  return f;
 }
 /// A nodal field kept between steps (see FieldRef::carried).
 inline FieldRef carried_node_field(std::string name, int components = 1) {

@@ -90,6 +90,20 @@ StepPlan StepPlan::resolve(std::vector<Declared> declared, const std::vector<std
         if (list == &d.stage.writes && f.carried) carried.insert(key(f));
       }
 
+  // Optional reads nobody provides leave the step: no writer in any stage, and not a particle
+  // field the scene has.
+  {
+    std::set<std::string> writers;
+    for (const auto& d : declared)
+      for (const auto& f : d.stage.writes) writers.insert(key(f));
+    for (auto& d : declared)
+      std::erase_if(d.stage.reads, [&](const FieldRef& f) {
+        return f.optional && !writers.count(key(f)) &&
+               !(f.location == FieldLocation::Particle &&
+                 std::find(particle_fields.begin(), particle_fields.end(), f.name) != particle_fields.end());
+      });
+  }
+
   std::vector<std::size_t> order;
   for (int p = 0; p < kPhaseCount; ++p) {
     std::vector<std::size_t> ids;

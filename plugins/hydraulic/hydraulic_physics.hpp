@@ -8,8 +8,7 @@
 // the drag coefficient C_d = n_l² ρ_l g_ref / (K k_r) (K the hydraulic conductivity, g_ref the
 // gravity it is defined with). Per step:
 //   map_to_grid   per-particle coefficients; the nodal pressure is carried between steps while
-//                 particles stand still (re-projected from the particles when they move); the
-//                 nodal liquid velocity of the step's start, for other physics;
+//                 particles stand still (re-projected from the particles when they move);
 //   predict       at every material point v* = (n_l ρ_l (v + Δt b) − Δt n_l ∇p(x_p)) /
 //                 (n_l ρ_l + Δt C_d) (Eq. 43 with the gradient form of the pressure force, Eq. 14);
 //   pressure      (M/Δt + K) Δp = Σ_p V_p n_l ∇S_ip · v*_p + ∫ S_i q̂ dS, M lumped
@@ -90,9 +89,9 @@ class HydraulicPhysics final : public Physics {
   std::vector<std::uint16_t> material_;
   std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
 
-  // ---- grid (the kernel's node fields pore_pressure, liquid_velocity, pressure_increment) and the
-  // lumped liquid mass (a node no wet particle touches has none and no pressure unknown)
-  std::vector<double>*p_ = nullptr, *v_ = nullptr, *dp_ = nullptr;
+  // ---- grid (the kernel's node fields pore_pressure and pressure_increment) and the lumped
+  // liquid mass (a node no wet particle touches has none and no pressure unknown)
+  std::vector<double>*p_ = nullptr, *dp_ = nullptr;
   std::vector<double> node_mass_, rhs_;
   ColouredBlocks<kDim> blocks_;
   std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
@@ -101,7 +100,9 @@ class HydraulicPhysics final : public Physics {
   // ---- pressure system
   StencilGraph graph_;
   std::unique_ptr<SparseSystem> system_;
-  std::vector<double> values_, assembled_values_;
+  std::vector<double> values_, assembled_values_;  ///< assembled_: the values the preconditioner saw
+  long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
+  bool refresh_due_ = false;
 
   // ---- step and counters
   double time_ = 0, dt_ = 0;

@@ -95,19 +95,23 @@ void HydraulicPhysics::assemble() {
 
 void HydraulicPhysics::solve_pressure() {
   assemble();
-  // The preconditioner is rebuilt only when the matrix changed (a thermal physics changing the
-  // ice content changes it; a steady-coefficient run keeps the first one).
+  // The matrix changes every step a thermal physics moves the ice, but only near the front:
+  // the preconditioner of an earlier step stays good. It is refreshed when the iteration count
+  // has grown by half over the count right after the last refresh (and built on a new graph).
   PreconditionerUpdate update = PreconditionerUpdate::Reuse;
   if (assembled_values_.empty()) update = PreconditionerUpdate::Rebuild;
-  else if (assembled_values_ != values_) update = PreconditionerUpdate::Refresh;
-  if (update != PreconditionerUpdate::Reuse) {
-    system_->set_values(values_);
-    assembled_values_ = values_;
-  }
+  else if (values_ != assembled_values_ && refresh_due_) update = PreconditionerUpdate::Refresh;
+  system_->set_values(values_);
+  if (update != PreconditionerUpdate::Reuse) assembled_values_ = values_;
   const auto start = std::chrono::steady_clock::now();
   const SolveStats stats = system_->solve(rhs_, *dp_, update);
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ++solves_;
+  if (update != PreconditionerUpdate::Reuse) {
+    iterations_after_refresh_ = stats.iterations;
+    ++preconditioner_updates_;
+  }
+  refresh_due_ = stats.iterations > 1.5 * iterations_after_refresh_ + 2;
   iterations_total_ += stats.iterations;
   iterations_max_ = std::max<long>(iterations_max_, stats.iterations);
   residual_max_ = std::max(residual_max_, stats.relative_residual);

@@ -29,6 +29,28 @@ void ThermalPhysics::conduction_force() {
   });
 }
 
+/// The convective term, explicit: a_i = −Σ_p V_p S_ip ρ_l c_l q_p·∇T(x_p) with the nodal
+/// temperatures of the step's start (the paper's Eq. A15, first term). Returns Σ_i a_i: heat
+/// carried in by the flow [W per m], part of the boundary heat in the energy balance.
+double ThermalPhysics::compute_advection() {
+  const auto& st = sim_->stencil();
+  const auto vol = sim_->particles().field("volume");
+  const auto q = sim_->particles().field("water_flux");
+  std::fill(advection_force_.begin(), advection_force_.end(), 0.0);
+  const int K = st.per_particle();
+  blocks_.for_each([&](std::size_t p) {
+    const auto* nodes = st.nodes(p);
+    const auto* w = st.weights(p);
+    const auto* g = st.gradients(p);
+    double rate = 0;
+    for (int k = 0; k < K; ++k)
+      for (int d = 0; d < kDim; ++d) rate += (*node_T_)[nodes[k]] * g[k * kDim + d] * q[p * kDim + d];
+    const double a = vol[p] * constants_[material_[p]].water_capacity * rate;
+    for (int k = 0; k < K; ++k) advection_force_[nodes[k]] -= a * w[k];
+  });
+  return reproducible_sum(advection_force_.size(), [&](std::size_t i) { return advection_force_[i]; });
+}
+
 double ThermalPhysics::boundary_flow(double time, const std::vector<double>& T, std::vector<double>& into) const {
   double total = 0;
   for (const auto& bc : flux_) {
@@ -54,7 +76,13 @@ double ThermalPhysics::boundary_flow(double time, const std::vector<double>& T, 
 
 void ThermalPhysics::solve_explicit() {
   conduction_force();
-  const double boundary = boundary_flow(time_, (*node_T_), node_force_);
+  double boundary = boundary_flow(time_, (*node_T_), node_force_);
+  if (advection_) {
+    const double advected = compute_advection();
+    for (std::size_t i = 0; i < node_force_.size(); ++i) node_force_[i] += advection_force_[i];
+    boundary += advected;
+    advected_heat_ += dt_ * advected;
+  }
   // Dirichlet nodes are reset to their target; what that takes beyond the heat the node's
   // neighbours and boundary flows gave it is the boundary's (the reaction).
   double reaction = 0;

@@ -166,6 +166,8 @@ bool ThermalPhysics::newton(double t_end, double h) {
     const double q = value_at(bc, t_end);
     for (std::size_t j = 0; j < bc.nodes.size(); ++j) boundary_load_[bc.nodes[j]] += q * bc.areas[j];
   }
+  if (advection_)
+    for (std::size_t i = 0; i < boundary_load_.size(); ++i) boundary_load_[i] += advection_force_[i];
   for (const auto& bc : convective_) {
     const double ambient = value_at(bc, t_end);
     for (std::size_t j = 0; j < bc.nodes.size(); ++j) {
@@ -224,6 +226,10 @@ void ThermalPhysics::solve_implicit() {
   if (!system_ || st.version() != graph_.stencil_version) build_graph();
   assemble_conductivity();
   preconditioner_fresh_ = false;  // the tangent's off-diagonal part changed with κ
+  // The convective term is lagged (the temperatures and flux of the step's start): a source for
+  // the whole step, so the Newton tangent stays symmetric (CG) and the step keeps its energy
+  // functional; stable_time_step() bounds Δt by 2α/u².
+  advected_rate_ = advection_ ? compute_advection() : 0.0;
   const std::size_t nodes = (*node_T_).size();
   const double end = time_ + dt_;
   long level = std::max(0L, halvings_ - 1);  // start one level coarser than last time
@@ -278,6 +284,7 @@ void ThermalPhysics::solve_implicit() {
       }
     }
     boundary_heat_ += h * flows + reaction;
+    advected_heat_ += h * advected_rate_;
     parallel_for(nodes, [&](std::size_t i) {
       if (is_free(i)) (*node_T_)[i] = nodal_.invert(i, node_heat_[i], (*node_T_)[i]);
     });

@@ -111,7 +111,8 @@ std::vector<Stage> ThermalPhysics::stages() {
              phi = particle_field("porosity"), vol = particle_field("volume"), x = particle_field("position", kDim);
   const auto T_node = node_field("temperature");
   return {{"thermal.map_to_grid", Phase::MapToGrid, {x, vol, phi, T, d}, {T_node}, [this] { map_to_grid(); }},
-          {"thermal.solve", Phase::Energy, {T_node}, {T_node},
+          // The convective term ρ_l c_l q·∇T, when some physics provides the Darcy flux q.
+          {"thermal.solve", Phase::Energy, {T_node, optional_read(particle_field("water_flux", kDim))}, {T_node},
            [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
           {"thermal.map_to_particles", Phase::MapToParticles, {T_node, x, vol, phi, T, d},
            {T, d, particle_field("temperature_pic"), particle_field("liquid_saturation")},
@@ -185,6 +186,8 @@ double ThermalPhysics::particle_heat_total() const {
 
 void ThermalPhysics::initialize() {
   node_T_ = &sim_->node_fields().values("temperature");
+  advection_ = sim_->particles().has("water_flux");
+  if (advection_) advection_force_.assign(node_T_->size(), 0.0);
   auto& particles = sim_->particles();
   auto T = particles.field("temperature");
   auto T_pic = particles.field("temperature_pic");
@@ -212,10 +215,28 @@ void ThermalPhysics::begin_step(double time, double dt) {
 }
 
 double ThermalPhysics::stable_time_step() const {
-  if (implicit_) return std::numeric_limits<double>::infinity();
   if (!initialized_) const_cast<ThermalPhysics*>(this)->initialize();
+  // The convective term is explicit (the flux of the step's start) in both schemes: with
+  // central differences it is stable while Δt ≤ 2α/u², u = ρ_l c_l |q| / C (von Neumann, with
+  // the diffusion explicit or implicit), whatever the cell size.
+  double dt = std::numeric_limits<double>::infinity();
+  if (advection_) {
+    const auto q = sim_->particles().field("water_flux");
+    const auto phi = sim_->particles().field("porosity");
+    dt = cfl_ * parallel_min(
+                    conductivity_.size(),
+                    [&](std::size_t p) {
+                      double q2 = 0;
+                      for (int d = 0; d < kDim; ++d) q2 += q[p * kDim + d] * q[p * kDim + d];
+                      const double Cw = constants_[material_[p]].water_capacity;
+                      return q2 > 0 ? 2.0 * conductivity_[p] * sensible_capacity(p, phi[p]) / (Cw * Cw * q2)
+                                    : std::numeric_limits<double>::infinity();
+                    },
+                    std::numeric_limits<double>::infinity());
+  }
+  if (implicit_) return dt;
   const double h = sim_->grid().min_spacing();
-  double dt = cfl_ * h * h / (2.0 * kDim * max_diffusivity_);
+  dt = std::min(dt, cfl_ * h * h / (2.0 * kDim * max_diffusivity_));
   // A convective face is a spring h·A on the node: keep Δt below C V_i/(h A_i) ≈ C (Δx/2)/h.
   for (const auto& bc : convective_) dt = std::min(dt, cfl_ * min_capacity_ * 0.5 * h / bc.coefficient);
   return dt;
@@ -481,7 +502,8 @@ void ThermalPhysics::apply_particle_dirichlet(double time, bool count_heat) {
 std::vector<PersistentArray> ThermalPhysics::persistent_state() {
   saved_scalars_ = {double(grid_valid_), double(halvings_), previous_substep_, initial_heat_, boundary_heat_, double(nonlinear_total_),
                     double(nonlinear_max_), double(linear_total_), double(rejected_substeps_), double(substeps_),
-                    double(clipped_), smallest_substep_, max_diffusivity_, min_capacity_, double(initialized_)};
+                    double(clipped_), smallest_substep_, max_diffusivity_, min_capacity_, double(initialized_),
+                    advected_heat_};
   return {{"node_heat", &node_heat_},
           {"node_temperature", node_T_},
           {"node_temperature_before", &node_T_before_},
@@ -491,7 +513,8 @@ std::vector<PersistentArray> ThermalPhysics::persistent_state() {
 
 void ThermalPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 15) throw std::runtime_error("thermal: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 15");
+  if (s.size() != 16) throw std::runtime_error("thermal: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 16");
+  advected_heat_ = s[15];
   grid_valid_ = s[0] != 0;
   halvings_ = long(s[1]);
   previous_substep_ = s[2];
@@ -537,6 +560,7 @@ std::vector<std::pair<std::string, double>> ThermalPhysics::statistics() const {
       {"thermal.energy_balance_error_J", error},
       {"thermal.energy_balance_error_relative", std::abs(error) / scale},
       {"thermal.energy_in_transit_J", pending},
+      {"thermal.energy_advected_in_J", advected_heat_},
       {"thermal.max_principle_clips", double(clipped_)}};
   if (implicit_) {
     out.insert(out.end(), {{"thermal.nonlinear_iterations_total", double(nonlinear_total_)},

@@ -124,6 +124,10 @@ class ThermalPhysics final : public Physics {
   bool initialized_ = false;
   double initial_heat_ = 0;    ///< Σ V_p H_p(T_p) at the start
   double boundary_heat_ = 0;   ///< heat that entered through boundaries so far [J per m thickness]
+  bool advection_ = false;     ///< the scene has a Darcy flux (particle field water_flux)
+  std::vector<double> advection_force_;  ///< convective term of this step, per node [W per m]
+  double advected_rate_ = 0;   ///< Σ_i advection_force_ [W per m]
+  double advected_heat_ = 0;   ///< heat carried in by the flow so far (included in boundary_heat_)
   long nonlinear_total_ = 0, nonlinear_max_ = 0, linear_total_ = 0, rejected_substeps_ = 0, substeps_ = 0,
        clipped_ = 0;
   double smallest_substep_ = std::numeric_limits<double>::infinity();
@@ -152,6 +156,7 @@ class ThermalPhysics final : public Physics {
   double particle_heat_total() const;
   // explicit_step.cpp
   void conduction_force();
+  double compute_advection();
   /// Adds the heat-flux and convective flows at `time` (convection from temperatures T) into
   /// `into`; returns their sum [W per m of thickness].
   double boundary_flow(double time, const std::vector<double>& T, std::vector<double>& into) const;
