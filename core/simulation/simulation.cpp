@@ -395,7 +395,13 @@ void Simulation::read_probes(const ConfigNode* node) {
       probe->name = item.child("name").as_string();
       if (probe->type == "integral") {
         for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
-        item.finish({"type", "name", "fields"});
+        if (auto scale = item.optional_child("scale")) {
+          probe->value = scale->as_real();
+          if (!std::isfinite(probe->value)) throw scale->error("scale must be a finite number");
+        } else {
+          probe->value = 1.0;
+        }
+        item.finish({"type", "name", "fields", "scale"});
       } else {
         probe->field = check_field(item.child("field"));
         if (probe->type == "value_at") {
@@ -546,7 +552,7 @@ std::vector<double> Simulation::evaluate_probes() const {
         for (const auto& c : cols) v *= c.values[p * c.stride + c.component];
         sum += v;
       }
-      out.push_back(sum);
+      out.push_back(probe->value * sum);
     } else if (probe->type == "value_at") {
       out.push_back(sample_field(probe->field, probe->point));
     } else {  // isotherm: distance from `from` to the first crossing of `value` along the line

@@ -20,10 +20,13 @@ ParamSchema HydraulicPhysics::schema() {
                                        "[m/s] is defined with (not the body force)")
       .defaults_to(9.81)
       .above(0);
-  s.choice("preconditioner", {"none", "jacobi", "ilu", "multigrid"}, "preconditioner of the CG pressure solve")
+  s.choice("solver", {"cg", "gmres"}, "Krylov method of the pressure solve (the matrix is symmetric positive "
+                                      "definite: CG; GMRES for comparison)")
+      .defaults_to("cg");
+  s.choice("preconditioner", {"none", "jacobi", "ilu", "multigrid"}, "preconditioner of the pressure solve")
       .defaults_to("multigrid");
   s.real("linear_tolerance", "-", "relative residual of the pressure solve").defaults_to(1e-8).above(0).below(1);
-  s.integer("max_linear_iterations", "CG iterations per pressure solve before the run stops")
+  s.integer("max_linear_iterations", "Krylov iterations per pressure solve before the run stops")
       .defaults_to(2000L)
       .at_least(1);
   return s;

@@ -19,7 +19,7 @@ void HydraulicPhysics::assemble() {
   if (!system_ || graph_.stencil_version != st.version()) {
     graph_.build(st, nodes);
     SolverOptions options;
-    options.method = "cg";
+    options.method = params_.string("solver");
     options.preconditioner = params_.string("preconditioner");
     options.tolerance = params_.real("linear_tolerance");
     options.max_iterations = static_cast<int>(params_.integer("max_linear_iterations"));
@@ -119,7 +119,7 @@ void HydraulicPhysics::solve_pressure() {
     std::ostringstream msg;
     msg << "pressure solve did not converge at t = " << time_ << " s (step " << sim_->step() << ", dt = " << dt_
         << " s): relative residual " << stats.relative_residual << " after " << stats.iterations
-        << " CG iterations (physics.hydraulic.linear_tolerance " << params_.real("linear_tolerance")
+        << " " << params_.string("solver") << " iterations (physics.hydraulic.linear_tolerance " << params_.real("linear_tolerance")
         << ", max_linear_iterations " << params_.integer("max_linear_iterations")
         << "); raise max_linear_iterations, try another preconditioner or a smaller time.dt";
     throw NumericalBlowUp(msg.str());

@@ -31,6 +31,11 @@ ParamSchema ThermalPhysics::schema() {
          "initial fields jump inside a cell")
       .defaults_to(0.0).at_least(0);
   s.real("cfl", "-", "explicit: fraction of the diffusion stability limit used as Δt").defaults_to(0.5).above(0).at_most(1);
+  s.real("advection_cfl", "-",
+         "with a water flux: fraction of the convective term's stability limit 2α/u² used as Δt (both schemes)")
+      .defaults_to(0.9)
+      .above(0)
+      .at_most(1);
   s.real("nonlinear_tolerance", "degC",
          "implicit: Newton stops when every node's energy residual is worth less than this much "
          "sensible heat")
@@ -51,6 +56,7 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
   flip_fraction_ = p.real("flip_fraction");
   pic_properties_ = p.string("property_temperature") == "pic";
   cfl_ = p.real("cfl");
+  advection_cfl_ = p.real("advection_cfl");
   subgrid_relaxation_ = p.real("subgrid_relaxation");
   nonlinear_tolerance_ = p.real("nonlinear_tolerance");
   max_nonlinear_iterations_ = p.integer("max_nonlinear_iterations");
@@ -223,7 +229,7 @@ double ThermalPhysics::stable_time_step() const {
   if (advection_) {
     const auto q = sim_->particles().field("water_flux");
     const auto phi = sim_->particles().field("porosity");
-    dt = cfl_ * parallel_min(
+    dt = advection_cfl_ * parallel_min(
                     conductivity_.size(),
                     [&](std::size_t p) {
                       double q2 = 0;

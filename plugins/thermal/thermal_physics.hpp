@@ -79,7 +79,7 @@ class ThermalPhysics final : public Physics {
   ParamSet params_;
   Simulation* sim_ = nullptr;
   bool implicit_ = false, pic_properties_ = true;
-  double flip_fraction_ = 1, subgrid_relaxation_ = 0, cfl_ = 0.5;
+  double flip_fraction_ = 1, subgrid_relaxation_ = 0, cfl_ = 0.5, advection_cfl_ = 0.9;
   double nonlinear_tolerance_ = 1e-6;
   long max_nonlinear_iterations_ = 25, max_step_halvings_ = 12;
   std::vector<PhaseConstants> constants_;

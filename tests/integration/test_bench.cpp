@@ -145,3 +145,23 @@ TEST_CASE("bench smoke test: stability names the valid keys of a bad --only", "[
   CHECK(r.exit_code != 0);
   CHECK(r.output.find("cell_size") != std::string::npos);
 }
+
+TEST_CASE("bench smoke test: frozen_inclusion prints its row with a thaw time and the INTERFROST range", "[bench]") {
+  TempDir dir;
+  // Case 3 on a 0.1 m grid (30 × 10 cells): about a second; the format is checked, not the physics.
+  const auto r = run_command("/usr/bin/python3 " + source_dir() + "/bench/frozen_inclusion --cases 3 --cells 0.1" +
+                             " --frostmpm " + frostmpm_exe() + " --runs " + dir.file("runs") + " --out " +
+                             dir.file("table.csv"));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.output.find("INTERFROST 13 codes h") != std::string::npos);
+  const CsvTable table = read_csv(dir.file("table.csv"));
+  REQUIRE(table.rows.size() == 1);
+  const auto& row = table.rows[0];
+  CHECK(row[table.column("case")] == 3);
+  CHECK(row[table.column("cell_m")] == 0.1);
+  CHECK(row[table.column("particles")] == 1200);
+  CHECK(row[table.column("thaw_h")] > 5);
+  CHECK(row[table.column("thaw_h")] < 30);
+  CHECK(row[table.column("V_l_end")] == Approx(1.11).epsilon(1e-9));
+}

@@ -116,3 +116,58 @@ TEST_CASE("pressure diffusion in a column matches Terzaghi's isochrones, second 
     CHECK(std::log2(error[0][i] / error[2][i]) / 2 > 1.8);  // measured 1.8–2.3 pairwise, 2.0–2.5 overall
   }
 }
+
+TEST_CASE("thaw with advection (Kurylyk et al. 2014, benchmarks 2 and 3): fronts of the quasi-steady closed form",
+          "[verification][hydraulic][thermo-hydraulic]") {
+  TempDir dir;
+  // X + (e^{−βX} − 1)/β = κ T_s β t / L_v, β = ρ_l c_l q / κ (VERIFICATION §1.2; 1–2 % approximate:
+  // it neglects the thawed zone's sensible heat, Stefan number 0.019), solved by bisection.
+  auto closed_form = [](double q, double t) {
+    const double kappa = 1.839, beta = 1000 * 4182 * q / kappa, rhs = kappa * 1.0 * beta * t / 1.67e8;
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 200; ++i) {
+      const double X = 0.5 * (lo + hi);
+      (X + (std::exp(-beta * X) - 1) / beta < rhs ? lo : hi) = X;
+    }
+    return 0.5 * (lo + hi);
+  };
+  // The published values the closed form must reproduce first (VERIFICATION §1.2).
+  const double q10 = 10.0 / (365.25 * 86400), q100 = 100.0 / (365.25 * 86400);
+  CHECK(closed_form(q10, 86400) == Approx(0.0439).margin(5e-5));
+  CHECK(closed_form(q10, 4 * 86400) == Approx(0.0882).margin(5e-5));
+  CHECK(closed_form(q100, 2 * 86400) == Approx(0.0666).margin(5e-5));
+  CHECK(closed_form(q100, 4 * 86400) == Approx(0.0974).margin(5e-5));
+  for (double q : {q10, q100}) {
+    std::vector<double> errors;
+    for (int cells : {100, 200}) {  // Δx = 5 and 2.5 mm
+      std::ostringstream flux;
+      flux.precision(17);
+      flux << "boundary_conditions.1.value=" << q;
+      const double h = 0.5 / cells;
+      std::ostringstream cmd;
+      cmd.precision(17);
+      cmd << "run " << source_dir() << "/configs/verification/kurylyk_advection.yaml -o " << dir.file("run")
+          << " --set 'grid.cells=[1," << cells << "]' --set grid.cell_size=" << h
+          << " --set 'regions.0.shape={box: {min: [0, 0], max: [" << h << ", 0.5]}}' --set '" << flux.str()
+          << "' --set output.progress=false";
+      const auto r = run_frostmpm(cmd.str());
+      INFO(r.output);
+      REQUIRE(r.exit_code == 0);
+      const auto t = read_csv(dir.file("run/metrics.csv"));
+      REQUIRE(t.rows.size() == 5);  // t = 0 … 4 d
+      double worst = 0;
+      for (int day : {1, 2, 4}) {
+        const double X = t.rows[day][t.column("half_thawed_depth")], exact = closed_form(q, day * 86400.0);
+        INFO("q = " << q << " m/s, Δx = " << h << " m, day " << day << ": front " << X << " m, closed form " << exact);
+        CHECK(std::abs(X - exact) / exact < 0.025);
+        worst = std::max(worst, std::abs(X - exact) / exact);
+        // The flux passes the frozen column unchanged (mass balance).
+        CHECK(t.rows[day][t.column("q_y_min")] == Approx(-q).epsilon(1e-6));
+        CHECK(t.rows[day][t.column("q_y_max")] == Approx(-q).epsilon(1e-6));
+      }
+      errors.push_back(worst);
+    }
+    WARN("Kurylyk advection q = " << q << " m/s: worst front error " << errors[0] << " (5 mm), " << errors[1]
+                                  << " (2.5 mm) against the quasi-steady closed form");
+  }
+}
