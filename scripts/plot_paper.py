@@ -40,37 +40,39 @@ def metrics(folder):
     return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
 
 
-def inclusion(folders, png):
+def two_panels(folders, left, right):
+    """T-like curve on the left, its companion on the right, one colour per run; returns the axes
+    and the colour of each run."""
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    colours = []
     for i, folder in enumerate(folders):
         m = metrics(folder)
         t = m["time_s"] / 3600
-        line, = a.plot(t, m["T_min"], label=LABELS[i] if i < 3 else folder)
-        b.plot(t, m["liquid_volume_m3"], color=line.get_color())
-        if i < 3:
-            a.axvspan(*INTERFROST_H[i], color=line.get_color(), alpha=0.15)
+        line, = a.plot(t, m[left], label=LABELS[i] if i < 3 else folder)
+        if right in m:
+            b.plot(t, m[right], color=line.get_color())
+        colours.append(line.get_color())
     a.axhline(0, color="k", lw=0.5)
+    a.legend()
+    return fig, a, b, colours
+
+
+def inclusion(folders, png):
+    fig, a, b, colours = two_panels(folders, "T_min", "liquid_volume_m3")
+    for i, colour in enumerate(colours[:3]):
+        a.axvspan(*INTERFROST_H[i], color=colour, alpha=0.15)
     a.set(xlabel="t [h]", ylabel="global T_min [°C]", title="T_min (shaded: INTERFROST thaw-time ranges)")
     b.axhline(1.0710, color="k", lw=0.5, ls=":")
     b.axhline(1.1100, color="k", lw=0.5, ls=":")
     b.set(xlabel="t [h]", ylabel="liquid water volume [m³ per m]", title="V_l (dotted: 1.0710, 1.1100)")
-    a.legend()
     fig.tight_layout()
     fig.savefig(png, dpi=120)
 
 
 def talik(folders, png):
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-    for i, folder in enumerate(folders):
-        m = metrics(folder)
-        t = m["time_s"] / 3600
-        line, = a.plot(t, m["T_center"], label=LABELS[i] if i < 3 else folder)
-        if "k_eq_m_per_s" in m:
-            b.plot(t, m["k_eq_m_per_s"], color=line.get_color())
-    a.axhline(0, color="k", lw=0.5)
+    fig, a, b, _ = two_panels(folders, "T_center", "k_eq_m_per_s")
     a.set(xlabel="t [h]", ylabel="T at A (0.5, 0.5) [°C]", title="temperature at the centre")
     b.set(xlabel="t [h]", ylabel="k_eq [m/s]", title="equivalent hydraulic conductivity at the outlet")
-    a.legend()
     fig.tight_layout()
     fig.savefig(png, dpi=120)
 

@@ -298,6 +298,19 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
   resolved_["boundary_conditions"] = YAML::Clone(node.raw());
 }
 
+std::vector<std::uint16_t> Simulation::particle_materials() const {
+  std::vector<std::uint16_t> material(particles_.size());
+  for (const auto& r : particles_.ranges())
+    std::fill(material.begin() + r.begin, material.begin() + r.end, static_cast<std::uint16_t>(r.material));
+  return material;
+}
+
+void Simulation::fill_from_materials(const std::string& field, const std::string& parameter) {
+  auto values = particles_.field(field);
+  for (const auto& r : particles_.ranges())
+    std::fill(values.begin() + r.begin, values.begin() + r.end, materials_[r.material].params.real(parameter));
+}
+
 void Simulation::resolve_step() {
   std::vector<StepPlan::Declared> declared;
   for (std::size_t i = 0; i < physics_.size(); ++i)

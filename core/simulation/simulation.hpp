@@ -3,6 +3,7 @@
 // materials, boundary conditions, the physics in play and their stages, output and probes.
 // 2-D today; grid, shape functions and stencils are templated on the dimension.
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -101,6 +102,10 @@ class Simulation {
   const Registry& registry() const { return registry_; }
   /// Boundary conditions whose type a physics owns.
   std::vector<BoundaryCondition*> boundary_conditions(const std::string& type);
+  /// The material index of every particle.
+  std::vector<std::uint16_t> particle_materials() const;
+  /// Sets a particle field to each particle's material parameter (before regions' `initial:`).
+  void fill_from_materials(const std::string& field, const std::string& parameter);
   /// Declares a particle field that regions may initialise with `initial: {name: value}`.
   void declare_state_field(const std::string& name, int components, double default_value);
   /// Fields a physics can offer to output and probes (declared state or derived fields).

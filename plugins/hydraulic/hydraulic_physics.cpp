@@ -7,6 +7,7 @@
 
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
+#include "frostmpm/transfer/nodal_interpolation.hpp"
 
 namespace frostmpm::hydraulic {
 
@@ -69,12 +70,8 @@ void HydraulicPhysics::setup(Simulation& sim) {
     compressible = compressible || models.compressibility > 0;
     materials_.push_back(std::move(models));
   }
-  auto phi = particles.field("porosity");
-  material_.resize(particles.size());
-  for (const auto& r : particles.ranges()) {
-    std::fill(phi.begin() + r.begin, phi.begin() + r.end, sim.materials()[r.material].params.real("porosity"));
-    std::fill(material_.begin() + r.begin, material_.begin() + r.end, static_cast<std::uint16_t>(r.material));
-  }
+  sim.fill_from_materials("porosity", "porosity");
+  material_ = sim.particle_materials();
   read_boundaries(sim);
   if (!compressible && pressure_bcs_.empty())
     throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
@@ -235,13 +232,8 @@ void HydraulicPhysics::predict() {
   auto& particles = sim_->particles();
   const auto v = particles.field("liquid_velocity");
   auto v_star = particles.field("liquid_velocity_predicted");
-  const int K = st.per_particle();
   parallel_for(particles.size(), [&](std::size_t q) {
-    const auto* nodes = st.nodes(q);
-    const auto* g = st.gradients(q);
-    std::array<double, kDim> grad{};
-    for (int k = 0; k < K; ++k)
-      for (int d = 0; d < kDim; ++d) grad[d] += g[k * kDim + d] * (*p_)[nodes[k]];
+    const auto grad = nodal_gradient_at(st, q, *p_);
     const double inertia = n_l_[q] * materials_[material_[q]].water_density, denominator = inertia + dt_ * drag_[q];
     for (int d = 0; d < kDim; ++d)
       v_star[q * kDim + d] = denominator > 0 ? (inertia * (v[q * kDim + d] + dt_ * gravity_[d]) -
@@ -258,13 +250,8 @@ void HydraulicPhysics::correct() {
   const auto v_star = particles.field("liquid_velocity_predicted");
   auto v = particles.field("liquid_velocity");
   auto flux = particles.field("water_flux");
-  const int K = st.per_particle();
   parallel_for(particles.size(), [&](std::size_t q) {
-    const auto* nodes = st.nodes(q);
-    const auto* g = st.gradients(q);
-    std::array<double, kDim> grad{};
-    for (int k = 0; k < K; ++k)
-      for (int d = 0; d < kDim; ++d) grad[d] += g[k * kDim + d] * (*dp_)[nodes[k]];
+    const auto grad = nodal_gradient_at(st, q, *dp_);
     const double a = dt_ * xi_[q] / materials_[material_[q]].water_density;
     for (int d = 0; d < kDim; ++d) {
       v[q * kDim + d] = v_star[q * kDim + d] - a * grad[d];
@@ -278,14 +265,7 @@ void HydraulicPhysics::correct() {
 void HydraulicPhysics::map_to_particles() {
   const auto& st = sim_->stencil();
   auto p = sim_->particles().field("pore_pressure");
-  const int K = st.per_particle();
-  parallel_for(p.size(), [&](std::size_t a) {
-    const auto* nodes = st.nodes(a);
-    const auto* w = st.weights(a);
-    double pressure = 0;
-    for (int k = 0; k < K; ++k) pressure += w[k] * (*p_)[nodes[k]];
-    p[a] = pressure;
-  });
+  parallel_for(p.size(), [&](std::size_t a) { p[a] = nodal_value_at(st, a, *p_); });
 }
 
 // ---- checkpoints and counters ----------------------------------------------------------------------

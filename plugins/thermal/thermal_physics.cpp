@@ -86,12 +86,8 @@ void ThermalPhysics::setup(Simulation& sim) {
     }
     tables.push_back(tables_.back().get());
   }
-  auto phi = particles.field("porosity");
-  material_.resize(particles.size());
-  for (const auto& r : particles.ranges()) {
-    std::fill(phi.begin() + r.begin, phi.begin() + r.end, sim.materials()[r.material].params.real("porosity"));
-    std::fill(material_.begin() + r.begin, material_.begin() + r.end, static_cast<std::uint16_t>(r.material));
-  }
+  sim.fill_from_materials("porosity", "porosity");
+  material_ = sim.particle_materials();
   read_boundaries(sim);
   if (implicit_ && sim.fixed_dt() <= 0)
     throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
