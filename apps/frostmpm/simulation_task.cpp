@@ -44,6 +44,12 @@ class SimulationTask final : public Task {
     s["physics"] = sim_.physics_names();
     for (const auto& physics : sim_.physics())
       for (const auto& [key, value] : physics->statistics()) s["counters"][key] = value;
+    for (const auto& physics : sim_.physics())
+      for (const auto& [key, values] : physics->step_series()) {
+        YAML::Node list(YAML::NodeType::Sequence);
+        for (double v : *values) list.push_back(v);
+        s["per_step"][key] = list;
+      }
     s["particles"] = static_cast<long>(sim_.particles().size());
     s["grid_nodes"] = static_cast<long>(sim_.grid().node_count());
     s["particle_fields"] = sim_.particles().field_names();

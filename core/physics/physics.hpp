@@ -71,6 +71,9 @@ class Physics {
   virtual void restored() {}
   /// Counters for run.json (e.g. linear iterations); keys are free-form.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
+  /// One value per step for run.json's `per_step` (e.g. a solver's iterations and final
+  /// residual of every step). Keep them in persistent_state() so a restart continues them.
+  virtual std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const { return {}; }
 };
 
 }  // namespace frostmpm

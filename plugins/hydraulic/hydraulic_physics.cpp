@@ -121,7 +121,8 @@ std::vector<Stage> HydraulicPhysics::stages() {
              v = particle_field("liquid_velocity", kDim), v_star = particle_field("liquid_velocity_predicted", kDim),
              q = particle_field("water_flux", kDim);
   // The nodal pressure is the state while particles stand still: carried between steps.
-  const auto p_node = carried_node_field("pore_pressure"), dp = node_field("pressure_increment");
+  // Δp is carried too: it is the next solve's first guess, so a restart needs it to continue bit for bit.
+  const auto p_node = carried_node_field("pore_pressure"), dp = carried_node_field("pressure_increment");
   return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p}, {p_node},
            [this] { map_to_grid(); }},
           {"hydraulic.predict", Phase::PredictMomentum, {p_node, v}, {v_star}, [this] { predict(); }},
@@ -272,12 +273,24 @@ void HydraulicPhysics::map_to_particles() {
 
 std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
-  return {{"scalars", &saved_scalars_}};
+  saved_scalars_.insert(saved_scalars_.end(), {double(iterations_after_refresh_), double(preconditioner_updates_),
+                                               double(refresh_due_)});
+  // The matrix values the preconditioner was built and last refreshed from: a restart rebuilds
+  // the same preconditioner, so the Krylov iterates (and the run) continue bit for bit.
+  return {{"scalars", &saved_scalars_},
+          {"step_iterations", &step_iterations_},
+          {"step_residuals", &step_residuals_},
+          {"preconditioner_build_values", &rebuild_values_},
+          {"preconditioner_values", &assembled_values_}};
 }
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 4) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 4");
+  if (s.size() != 7) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 7");
+  iterations_after_refresh_ = long(s[4]);
+  preconditioner_updates_ = long(s[5]);
+  refresh_due_ = s[6] != 0;
+  restoring_preconditioner_ = true;
   solves_ = long(s[0]);
   iterations_total_ = long(s[1]);
   iterations_max_ = long(s[2]);

@@ -56,6 +56,9 @@ class HydraulicPhysics final : public Physics {
   std::vector<PersistentArray> persistent_state() override;
   void restored() override;
   std::vector<std::pair<std::string, double>> statistics() const override;
+  std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const override {
+    return {{"hydraulic.linear_iterations", &step_iterations_}, {"hydraulic.relative_residual", &step_residuals_}};
+  }
 
  private:
   struct PressureCondition {
@@ -101,6 +104,8 @@ class HydraulicPhysics final : public Physics {
   StencilGraph graph_;
   std::unique_ptr<SparseSystem> system_;
   std::vector<double> values_, assembled_values_;  ///< assembled_: the values the preconditioner saw
+  std::vector<double> rebuild_values_;             ///< the values of its last full build
+  bool restoring_preconditioner_ = false;          ///< rebuild it from the checkpoint's values first
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
   bool refresh_due_ = false;
 
@@ -109,6 +114,7 @@ class HydraulicPhysics final : public Physics {
   long solves_ = 0, iterations_total_ = 0, iterations_max_ = 0;
   double residual_max_ = 0, solve_seconds_ = 0;
   std::vector<double> saved_scalars_;
+  std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
   void read_boundaries(Simulation& sim);
   double pressure_value(const PressureCondition& c, std::size_t node, double t) const;

@@ -3,6 +3,7 @@
 // column against Terzaghi's series (VERIFICATION §2.1; fixed skeleton, compressible water).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -55,6 +56,15 @@ TEST_CASE("steady Darcy flow in a column: linear pressure and the exact flux at 
     CHECK(last[t.column("q_max")] == Approx(1e-5).epsilon(1e-7));
     CHECK(last[t.column("p_mid")] == Approx(4905.0).epsilon(1e-8));
     CHECK(last[t.column("p_max")] == Approx(9810.0 * (1 - 0.25 / cells)).epsilon(1e-8));
+    // run.json keeps the pressure solver's iterations and final residual of every step.
+    const std::string json = read_file(dir.file("darcy" + std::to_string(cells) + "/run.json"));
+    for (const std::string key : {"hydraulic.linear_iterations", "hydraulic.relative_residual"}) {
+      const auto open = json.find("\"" + key + "\": [");
+      REQUIRE(open != std::string::npos);
+      const auto close = json.find(']', open);
+      const std::string list = json.substr(open, close - open);
+      CHECK(std::count(list.begin(), list.end(), ',') + 1 == 10);  // 10 steps of 1 s
+    }
   }
 }
 
