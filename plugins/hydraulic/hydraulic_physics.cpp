@@ -73,6 +73,14 @@ void HydraulicPhysics::setup(Simulation& sim) {
   sim.fill_from_materials("porosity", "porosity");
   material_ = sim.particle_materials();
   read_boundaries(sim);
+  // A hydrostatic boundary acts on nodes, not on a material: it needs one water density.
+  hydrostatic_density_ = materials_.front().water_density;
+  for (const auto& bc : pressure_bcs_)
+    if (bc.hydrostatic)
+      for (const auto& m : sim.materials())
+        if (m.params.real("water_density") != hydrostatic_density_)
+          throw m.params.error("water_density", "a hydrostatic pore_pressure boundary (" + bc.label +
+                                                    ") needs one water density in every material");
   if (!compressible && pressure_bcs_.empty())
     throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
                      "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
@@ -101,18 +109,26 @@ void HydraulicPhysics::read_boundaries(Simulation& sim) {
   }
 }
 
-double HydraulicPhysics::pressure_value(const PressureCondition& c, std::size_t node, double t) const {
-  double v = c.value(t);
-  const auto x = sim_->grid().node_position(node);
-  if (c.hydrostatic) {  // value = water-table elevation: p = ρ_l g (h − y)
-    double rho = materials_.empty() ? 1000.0 : materials_[0].water_density;
-    v = rho * reference_gravity_ * (v - x[kDim - 1]);
+std::vector<double> HydraulicPhysics::boundary_pressures(const PressureCondition& c, double t) const {
+  const double v = c.value(t);  // once per condition: a table or expression is not cheap
+  std::vector<double> p(c.nodes.size(), v);
+  for (std::size_t j = 0; j < c.nodes.size(); ++j) {
+    const auto x = sim_->grid().node_position(c.nodes[j]);
+    if (c.hydrostatic) p[j] = hydrostatic_density_ * reference_gravity_ * (v - x[kDim - 1]);  // v: water table
+    if (std::isfinite(p[j])) continue;
+    std::ostringstream msg;
+    msg << "numerical blow-up: pore pressure boundary value " << p[j] << " from the " << c.label << " (x = " << x[0]
+        << ", y = " << x[1] << ") at t = " << t << " s, step " << sim_->step() << "; check the value's table or expression";
+    throw NumericalBlowUp(msg.str());
   }
-  if (std::isfinite(v)) return v;
-  std::ostringstream msg;
-  msg << "numerical blow-up: pore pressure boundary value " << v << " from the " << c.label << " (x = " << x[0]
-      << ", y = " << x[1] << ") at t = " << t << " s, step " << sim_->step() << "; check the value's table or expression";
-  throw NumericalBlowUp(msg.str());
+  return p;
+}
+
+void HydraulicPhysics::set_boundary_pressures(double t) {
+  for (const auto& bc : pressure_bcs_) {
+    const auto p = boundary_pressures(bc, t);
+    for (std::size_t j = 0; j < bc.nodes.size(); ++j) (*p_)[bc.nodes[j]] = p[j];
+  }
 }
 
 std::vector<Stage> HydraulicPhysics::stages() {
@@ -198,8 +214,7 @@ void HydraulicPhysics::project_to_grid() {
     }
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] = weight[i] > 0 ? (*p_)[i] / weight[i] : 0.0; });
-  for (const auto& bc : pressure_bcs_)
-    for (std::size_t i : bc.nodes) (*p_)[i] = pressure_value(bc, i, time_);
+  set_boundary_pressures(time_);
   projected_version_ = st.version();
   grid_valid_ = true;
 }
@@ -221,8 +236,7 @@ void HydraulicPhysics::map_to_grid() {
     for (int k = 0; k < K; ++k) node_mass_[nodes[k]] += w[k] * m;
   });
   // Boundary pressures at the step's start (a time function moves them between steps).
-  for (const auto& bc : pressure_bcs_)
-    for (std::size_t i : bc.nodes) (*p_)[i] = pressure_value(bc, i, time_);
+  set_boundary_pressures(time_);
 }
 
 /// At every particle, v* = (n_l ρ_l v + Δt (−n_l ∇p(x_p) + n_l ρ_l b)) / (n_l ρ_l + Δt C_d):
@@ -273,24 +287,14 @@ void HydraulicPhysics::map_to_particles() {
 
 std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
-  saved_scalars_.insert(saved_scalars_.end(), {double(iterations_after_refresh_), double(preconditioner_updates_),
-                                               double(refresh_due_)});
-  // The matrix values the preconditioner was built and last refreshed from: a restart rebuilds
-  // the same preconditioner, so the Krylov iterates (and the run) continue bit for bit.
-  return {{"scalars", &saved_scalars_},
-          {"step_iterations", &step_iterations_},
-          {"step_residuals", &step_residuals_},
-          {"preconditioner_build_values", &rebuild_values_},
-          {"preconditioner_values", &assembled_values_}};
+  saved_scalars_.push_back(double(preconditioner_updates_));
+  return {{"scalars", &saved_scalars_}, {"step_iterations", &step_iterations_}, {"step_residuals", &step_residuals_}};
 }
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 7) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 7");
-  iterations_after_refresh_ = long(s[4]);
-  preconditioner_updates_ = long(s[5]);
-  refresh_due_ = s[6] != 0;
-  restoring_preconditioner_ = true;
+  if (s.size() != 5) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 5");
+  preconditioner_updates_ = long(s[4]);
   solves_ = long(s[0]);
   iterations_total_ = long(s[1]);
   iterations_max_ = long(s[2]);

@@ -84,6 +84,7 @@ class HydraulicPhysics final : public Physics {
   Simulation* sim_ = nullptr;
   std::array<double, kDim> gravity_{};
   double reference_gravity_ = 9.81;
+  double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
   std::vector<PressureCondition> pressure_bcs_;
   std::vector<FluxCondition> flux_bcs_;
@@ -103,11 +104,10 @@ class HydraulicPhysics final : public Physics {
   // ---- pressure system
   StencilGraph graph_;
   std::unique_ptr<SparseSystem> system_;
-  std::vector<double> values_, assembled_values_;  ///< assembled_: the values the preconditioner saw
-  std::vector<double> rebuild_values_;             ///< the values of its last full build
-  bool restoring_preconditioner_ = false;          ///< rebuild it from the checkpoint's values first
+  std::vector<double> values_;
+  bool preconditioner_built_ = false;  ///< for the current system (a restart builds a new one)
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
-  bool refresh_due_ = false;
+  bool refresh_due_ = false;           ///< the iteration count grew by half since the last update
 
   // ---- step and counters
   double time_ = 0, dt_ = 0;
@@ -117,7 +117,10 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
   void read_boundaries(Simulation& sim);
-  double pressure_value(const PressureCondition& c, std::size_t node, double t) const;
+  /// The condition's pressure on each of its nodes at time t; not finite stops the run.
+  std::vector<double> boundary_pressures(const PressureCondition& c, double t) const;
+  /// Nodal pressure = the boundary values at t on every pressure boundary.
+  void set_boundary_pressures(double t);
   void update_coefficients();
   void project_to_grid();
   void map_to_grid();

@@ -24,10 +24,7 @@ void HydraulicPhysics::assemble() {
     options.tolerance = params_.real("linear_tolerance");
     options.max_iterations = static_cast<int>(params_.integer("max_linear_iterations"));
     system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
-    if (!restoring_preconditioner_) {
-      assembled_values_.clear();
-      rebuild_values_.clear();
-    }
+    preconditioner_built_ = false;
   }
   values_.assign(graph_.nonzeros(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
@@ -76,11 +73,13 @@ void HydraulicPhysics::assemble() {
       fixed[i] = 1;
       dp[i] = 0.0;
     }
-  for (const auto& bc : pressure_bcs_)
-    for (std::size_t i : bc.nodes) {
-      dp[i] = pressure_value(bc, i, time_ + dt_) - (*p_)[i];
-      fixed[i] = 1;
+  for (const auto& bc : pressure_bcs_) {
+    const auto target = boundary_pressures(bc, time_ + dt_);
+    for (std::size_t j = 0; j < bc.nodes.size(); ++j) {
+      dp[bc.nodes[j]] = target[j] - (*p_)[bc.nodes[j]];
+      fixed[bc.nodes[j]] = 1;
     }
+  }
   for (std::size_t i = 0; i < nodes; ++i) {
     if (!fixed[i]) continue;
     for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) {
@@ -101,26 +100,10 @@ void HydraulicPhysics::solve_pressure() {
   // The matrix changes every step a thermal physics moves the ice, but only near the front:
   // the preconditioner of an earlier step stays good. It is refreshed when the iteration count
   // has grown by half over the count right after the last refresh (and built on a new graph).
-  if (restoring_preconditioner_) {  // after a restart: the preconditioner of the interrupted run
-    restoring_preconditioner_ = false;
-    if (!rebuild_values_.empty() && rebuild_values_.size() == values_.size()) {
-      std::vector<double> zero(rhs_.size(), 0.0), x(rhs_.size(), 0.0);
-      system_->set_values(rebuild_values_);
-      system_->solve(zero, x, PreconditionerUpdate::Rebuild);
-      if (assembled_values_ != rebuild_values_) {
-        system_->set_values(assembled_values_);
-        system_->solve(zero, x, PreconditionerUpdate::Refresh);
-      }
-    } else {
-      assembled_values_.clear();
-    }
-  }
-  PreconditionerUpdate update = PreconditionerUpdate::Reuse;
-  if (assembled_values_.empty()) update = PreconditionerUpdate::Rebuild;
-  else if (values_ != assembled_values_ && refresh_due_) update = PreconditionerUpdate::Refresh;
+  const PreconditionerUpdate update = !preconditioner_built_ ? PreconditionerUpdate::Rebuild
+                                     : refresh_due_         ? PreconditionerUpdate::Refresh
+                                                            : PreconditionerUpdate::Reuse;
   system_->set_values(values_);
-  if (update != PreconditionerUpdate::Reuse) assembled_values_ = values_;
-  if (update == PreconditionerUpdate::Rebuild) rebuild_values_ = values_;
   const auto start = std::chrono::steady_clock::now();
   const SolveStats stats = system_->solve(rhs_, *dp_, update);
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -130,6 +113,7 @@ void HydraulicPhysics::solve_pressure() {
   if (update != PreconditionerUpdate::Reuse) {
     iterations_after_refresh_ = stats.iterations;
     ++preconditioner_updates_;
+    preconditioner_built_ = true;
   }
   refresh_due_ = stats.iterations > 1.5 * iterations_after_refresh_ + 2;
   iterations_total_ += stats.iterations;

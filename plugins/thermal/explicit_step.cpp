@@ -7,12 +7,19 @@
 
 namespace frostmpm::thermal {
 
-/// f_i = −Σ_p V_p κ_p ∇S_ip·∇T_p with ∇T_p = Σ_j T_j ∇S_jp (matrix-free, coloured scatter),
-/// plus the boundary heat flows at time_; returns Σ of the boundary flows [W per m].
-void ThermalPhysics::conduction_force() {
+/// The particles' flows at the nodal temperatures T_i, with ∇T_p = Σ_j T_j ∇S_jp computed once
+/// per particle (matrix-free, coloured scatter):
+///  - conduction, into node_force_: f_i = −Σ_p V_p κ_p ∇S_ip·∇T_p;
+///  - convection, into advection_force_: a_i = −Σ_p V_p S_ip ρ_l c_l q_p·∇T_p with the particle
+///    Darcy flux q_p (the paper's Eq. A15, first term; explicit in both schemes).
+/// Returns Σ_i a_i: heat carried in by the flow [W per m], part of the boundary heat in the
+/// energy balance (0 without convection).
+double ThermalPhysics::particle_flows(bool conduction, bool convection) {
   const auto& st = sim_->stencil();
   const auto vol = sim_->particles().field("volume");
-  std::fill(node_force_.begin(), node_force_.end(), 0.0);
+  const auto q = convection ? sim_->particles().field("water_flux") : std::span<double>{};
+  if (conduction) std::fill(node_force_.begin(), node_force_.end(), 0.0);
+  if (convection) std::fill(advection_force_.begin(), advection_force_.end(), 0.0);
   const int K = st.per_particle();
   blocks_.for_each([&](std::size_t p) {
     const auto* nodes = st.nodes(p);
@@ -20,34 +27,23 @@ void ThermalPhysics::conduction_force() {
     double grad[kDim] = {};
     for (int k = 0; k < K; ++k)
       for (int d = 0; d < kDim; ++d) grad[d] += (*node_T_)[nodes[k]] * g[k * kDim + d];
-    const double a = vol[p] * conductivity_[p];
-    for (int k = 0; k < K; ++k) {
-      double dot = 0;
-      for (int d = 0; d < kDim; ++d) dot += g[k * kDim + d] * grad[d];
-      node_force_[nodes[k]] -= a * dot;
+    if (conduction) {
+      const double a = vol[p] * conductivity_[p];
+      for (int k = 0; k < K; ++k) {
+        double dot = 0;
+        for (int d = 0; d < kDim; ++d) dot += g[k * kDim + d] * grad[d];
+        node_force_[nodes[k]] -= a * dot;
+      }
+    }
+    if (convection) {
+      double rate = 0;
+      for (int d = 0; d < kDim; ++d) rate += q[p * kDim + d] * grad[d];
+      const double a = vol[p] * constants_[material_[p]].water_capacity * rate;
+      const auto* w = st.weights(p);
+      for (int k = 0; k < K; ++k) advection_force_[nodes[k]] -= a * w[k];
     }
   });
-}
-
-/// The convective term, explicit: a_i = −Σ_p V_p S_ip ρ_l c_l q_p·∇T(x_p) with the nodal
-/// temperatures of the step's start (the paper's Eq. A15, first term). Returns Σ_i a_i: heat
-/// carried in by the flow [W per m], part of the boundary heat in the energy balance.
-double ThermalPhysics::compute_advection() {
-  const auto& st = sim_->stencil();
-  const auto vol = sim_->particles().field("volume");
-  const auto q = sim_->particles().field("water_flux");
-  std::fill(advection_force_.begin(), advection_force_.end(), 0.0);
-  const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t p) {
-    const auto* nodes = st.nodes(p);
-    const auto* w = st.weights(p);
-    const auto* g = st.gradients(p);
-    double rate = 0;
-    for (int k = 0; k < K; ++k)
-      for (int d = 0; d < kDim; ++d) rate += (*node_T_)[nodes[k]] * g[k * kDim + d] * q[p * kDim + d];
-    const double a = vol[p] * constants_[material_[p]].water_capacity * rate;
-    for (int k = 0; k < K; ++k) advection_force_[nodes[k]] -= a * w[k];
-  });
+  if (!convection) return 0.0;
   return reproducible_sum(advection_force_.size(), [&](std::size_t i) { return advection_force_[i]; });
 }
 
@@ -75,10 +71,9 @@ double ThermalPhysics::boundary_flow(double time, const std::vector<double>& T, 
 }
 
 void ThermalPhysics::solve_explicit() {
-  conduction_force();
+  const double advected = particle_flows(/*conduction=*/true, /*convection=*/advection_);
   double boundary = boundary_flow(time_, (*node_T_), node_force_);
   if (advection_) {
-    const double advected = compute_advection();
     for (std::size_t i = 0; i < node_force_.size(); ++i) node_force_[i] += advection_force_[i];
     boundary += advected;
     advected_heat_ += dt_ * advected;

@@ -229,7 +229,7 @@ void ThermalPhysics::solve_implicit() {
   // The convective term is lagged (the temperatures and flux of the step's start): a source for
   // the whole step, so the Newton tangent stays symmetric (CG) and the step keeps its energy
   // functional; stable_time_step() bounds Δt by 2α/u².
-  advected_rate_ = advection_ ? compute_advection() : 0.0;
+  advected_rate_ = advection_ ? particle_flows(/*conduction=*/false, /*convection=*/true) : 0.0;
   const std::size_t nodes = (*node_T_).size();
   const double end = time_ + dt_;
   long level = std::max(0L, halvings_ - 1);  // start one level coarser than last time

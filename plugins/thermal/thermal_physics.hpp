@@ -155,8 +155,7 @@ class ThermalPhysics final : public Physics {
   void apply_particle_dirichlet(double time, bool count_heat);
   double particle_heat_total() const;
   // explicit_step.cpp
-  void conduction_force();
-  double compute_advection();
+  double particle_flows(bool conduction, bool convection);
   /// Adds the heat-flux and convective flows at `time` (convection from temperatures T) into
   /// `into`; returns their sum [W per m of thickness].
   double boundary_flow(double time, const std::vector<double>& T, std::vector<double>& into) const;

@@ -11,6 +11,7 @@
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
 #include "frostmpm/simulation/simulation.hpp"
+#include "frostmpm/transfer/nodal_interpolation.hpp"
 
 namespace grid_sampler {
 
@@ -51,14 +52,7 @@ class GridSampler final : public Physics {
     const auto& stencil = sim_->stencil();
     const auto nodal = sim_->node_fields().field(field_);
     auto out = sim_->particles().field(field_ + "_sampled");
-    const int K = stencil.per_particle();
-    for (std::size_t p = 0; p < out.size(); ++p) {
-      const auto* nodes = stencil.nodes(p);
-      const auto* w = stencil.weights(p);
-      double sum = 0;
-      for (int k = 0; k < K; ++k) sum += w[k] * nodal[nodes[k]];
-      out[p] = sum;
-    }
+    for (std::size_t p = 0; p < out.size(); ++p) out[p] = nodal_value_at(stencil, p, nodal);
   }
 };
 
