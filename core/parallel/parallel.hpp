@@ -22,10 +22,15 @@ inline int thread_count() {
 #endif
 }
 
+/// Below this many iterations a loop runs on the calling thread: waking the team costs more
+/// than a small scene's loop (and far more on a loaded machine). Serial and parallel runs of
+/// these loops give the same bits, so the threshold changes no result.
+inline constexpr std::size_t kParallelMinimum = 4096;
+
 /// f(i) for i in [0, n), statically split over the threads.
 template <class F>
 void parallel_for(std::size_t n, F&& f) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t i = 0; i < n; ++i) f(i);
 }
 
@@ -36,7 +41,7 @@ double reproducible_sum(std::size_t n, F&& f) {
   constexpr std::size_t kChunk = 2048;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<double> partial(chunks, 0.0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (chunks > 1)
   for (std::size_t c = 0; c < chunks; ++c) {
     double s = 0;
     const std::size_t end = std::min(n, (c + 1) * kChunk);
@@ -52,7 +57,7 @@ double reproducible_sum(std::size_t n, F&& f) {
 template <class F>
 double parallel_max(std::size_t n, F&& f, double empty) {
   double m = empty;
-#pragma omp parallel for schedule(static) reduction(max : m)
+#pragma omp parallel for schedule(static) reduction(max : m) if (n >= kParallelMinimum)
   for (std::size_t i = 0; i < n; ++i) m = std::max(m, f(i));
   return m;
 }

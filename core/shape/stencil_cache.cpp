@@ -1,5 +1,7 @@
 #include "frostmpm/shape/stencil_cache.hpp"
 
+#include "frostmpm/parallel/parallel.hpp"
+
 #include <algorithm>
 
 namespace frostmpm {
@@ -16,7 +18,7 @@ long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const dou
   gradient_.resize(n * K * Dim);
   long outside = -1;
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
     std::array<std::array<double, 4>, Dim> w{}, g{};
     std::array<int, Dim> base{};

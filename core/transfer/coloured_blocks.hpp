@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
 
 namespace frostmpm {
@@ -35,9 +36,10 @@ class ColouredBlocks {
   /// particles of a block in index order. f may scatter into any node of p's stencil.
   template <class F>
   void for_each(F&& f) const {
+    const bool parallel = order_.size() >= kParallelMinimum;  // see parallel.hpp
     for (int c = 0; c < kColours; ++c) {
       const std::uint32_t first = colour_begin_[c], last = colour_begin_[c + 1];
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) if (parallel)
       for (std::uint32_t b = first; b < last; ++b)
         for (std::uint32_t k = block_begin_[b]; k < block_begin_[b + 1]; ++k) f(std::size_t{order_[k]});
     }

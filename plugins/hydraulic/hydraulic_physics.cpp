@@ -30,6 +30,11 @@ ParamSchema HydraulicPhysics::schema() {
   s.integer("max_linear_iterations", "Krylov iterations per pressure solve before the run stops")
       .defaults_to(2000L)
       .at_least(1);
+  s.real("stabilization", "-",
+         "τ of the polynomial pressure projection (Eqs. 66–67): adds τ/(2G) ∫(S−ΠS)ᵀ(S−ΠS) dV · Δp/Δt, G the "
+         "material's shear_modulus; damps checkerboard pressure modes; 0 switches it off")
+      .defaults_to(1.0)
+      .at_least(0);
   return s;
 }
 
@@ -45,6 +50,15 @@ ParamSchema HydraulicPhysics::material_schema() const {
   s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0);
   s.real("water_compressibility", "1/Pa", "compressibility of pore water c_w = 1/K_l (INTERFROST: 1e-8)")
       .defaults_to(4.6e-10)
+      .at_least(0);
+  s.real("ice_density", "kg/m^3", "intrinsic density of ice ρ_c").defaults_to(917.0).above(0);
+  s.real("solid_thermal_expansion", "1/K", "volumetric thermal expansion of the soil grains β_s").defaults_to(0.0);
+  s.real("water_thermal_expansion", "1/K", "volumetric thermal expansion of water β_l").defaults_to(0.0);
+  s.real("ice_thermal_expansion", "1/K", "volumetric thermal expansion of ice β_c").defaults_to(0.0);
+  s.real("shear_modulus", "Pa",
+         "shear modulus G of the skeleton in the pressure stabilization τ/(2G); 0: a rigid skeleton (G → ∞), "
+         "no stabilization")
+      .defaults_to(0.0)
       .at_least(0);
   return s;
 }
@@ -67,6 +81,13 @@ void HydraulicPhysics::setup(Simulation& sim) {
       models.relative = m.models.at("relative_permeability").create<RelativePermeabilityModel>(sim.registry());
     models.water_density = m.params.real("water_density");
     models.compressibility = m.params.real("water_compressibility");
+    models.zeta = 1.0 - m.params.real("ice_density") / models.water_density;
+    models.solid_expansion = m.params.real("solid_thermal_expansion");
+    models.water_expansion = m.params.real("water_thermal_expansion");
+    models.ice_expansion = m.params.real("ice_thermal_expansion");
+    const double G = m.params.real("shear_modulus");
+    models.stabilization = G > 0 ? params_.real("stabilization") / (2.0 * G) : 0.0;
+    stabilized_ = stabilized_ || models.stabilization > 0;
     compressible = compressible || models.compressibility > 0;
     materials_.push_back(std::move(models));
   }
@@ -86,8 +107,14 @@ void HydraulicPhysics::setup(Simulation& sim) {
                      "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
   const std::size_t n = particles.size(), nodes = sim.grid().node_count();
-  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_}) v->assign(n, 0.0);
-  for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
+  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_})
+    v->assign(n, 0.0);
+  for (auto* v : {&node_mass_, &rhs_, &node_storage_, &node_source_}) v->assign(nodes, 0.0);
+  if (stabilized_) {
+    std::size_t cells = 1;
+    for (int d = 0; d < kDim; ++d) cells *= static_cast<std::size_t>(sim.grid().cells[d]);
+    cell_stabilization_.assign(cells, 0.0);
+  }
 }
 
 void HydraulicPhysics::read_boundaries(Simulation& sim) {
@@ -139,7 +166,9 @@ std::vector<Stage> HydraulicPhysics::stages() {
   // The nodal pressure is the state while particles stand still: carried between steps.
   // Δp is carried too: it is the next solve's first guess, so a restart needs it to continue bit for bit.
   const auto p_node = carried_node_field("pore_pressure"), dp = carried_node_field("pressure_increment");
-  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p}, {p_node},
+  // The phase change and the thermal expansion need the temperature when a thermal physics has it.
+  const auto T = optional_read(particle_field("temperature"));
+  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T}, {p_node},
            [this] { map_to_grid(); }},
           {"hydraulic.predict", Phase::PredictMomentum, {p_node, v}, {v_star}, [this] { predict(); }},
           {"hydraulic.pressure", Phase::Pressure, {v_star, p_node}, {dp}, [this] { solve_pressure(); }},
@@ -151,6 +180,7 @@ void HydraulicPhysics::initialize() {
   auto& nf = sim_->node_fields();
   p_ = &nf.values("pore_pressure");
   dp_ = &nf.values("pressure_increment");
+  temperature_ = sim_->particles().has("temperature");
   time_ = sim_->time();
   update_coefficients();
   project_to_grid();
@@ -219,21 +249,61 @@ void HydraulicPhysics::project_to_grid() {
   grid_valid_ = true;
 }
 
+/// source_p = [ζ φ ΔS_l − β_m ΔT] / Δt over the step that just ended (Eq. 48's
+/// (ζ φ ∂S_l/∂T − β_m) Ṫ in secant form): the particles' S_l and T change at the end of a step,
+/// so the pressure solve of step k+1 takes the change made in step k. The volume it removes
+/// over a run is exactly ζ φ ΔS_l − β_m ΔT of every particle.
+void HydraulicPhysics::update_source() {
+  auto& particles = sim_->particles();
+  const auto phi = particles.field("porosity");
+  const auto S = particles.field("liquid_saturation");
+  const double* T = temperature_ ? particles.field("temperature").data() : nullptr;
+  const auto vol = particles.field("volume");
+  if (!primed_) {
+    std::copy(S.begin(), S.end(), S_prev_.begin());
+    if (T) std::copy(T, T + particles.size(), T_prev_.begin());
+    primed_ = true;
+  }
+  parallel_for(particles.size(), [&](std::size_t p) {
+    const auto& m = materials_[material_[p]];
+    const double s = std::clamp(S[p], 0.0, 1.0), n_c = phi[p] * (1.0 - s);
+    const double beta = (1.0 - phi[p]) * m.solid_expansion + phi[p] * s * m.water_expansion +
+                        (1.0 - m.zeta) * n_c * m.ice_expansion;
+    const double dT = T ? T[p] - T_prev_[p] : 0.0;
+    source_[p] = (m.zeta * phi[p] * (s - std::clamp(S_prev_[p], 0.0, 1.0)) - beta * dT) / dt_;
+    S_prev_[p] = S[p];
+    if (T) T_prev_[p] = T[p];
+  });
+  source_volume_ += dt_ * reproducible_sum(particles.size(), [&](std::size_t p) { return vol[p] * source_[p]; });
+}
+
 void HydraulicPhysics::map_to_grid() {
   update_coefficients();
+  update_source();
   const auto& st = sim_->stencil();
   if (!grid_valid_ || st.version() != projected_version_) project_to_grid();
-  // The liquid mass marks the nodes the pressure lives on (a node no wet particle touches has
-  // no unknown). Other physics read the flux at the particles (water_flux), where the pressure
-  // equation's quadrature makes it mass-conserving: no nodal velocity is needed.
+  // The liquid mass marks the nodes the pressure lives on: a node whose pores hold less than
+  // kWetFraction liquid (none, or ice all but completely) has no unknown — its row would be
+  // scaled like n_l² (1e-300 where an SFCC underflows) and break the Krylov solver. Other
+  // physics read the flux at the particles (water_flux), where the pressure equation's
+  // quadrature makes it mass-conserving: no nodal velocity is needed.
+  constexpr double kWetFraction = 1e-12;
   const auto vol = sim_->particles().field("volume");
+  const auto phi = sim_->particles().field("porosity");
   std::fill(node_mass_.begin(), node_mass_.end(), 0.0);
+  std::vector<double> pore_mass(node_mass_.size(), 0.0);
   const int K = st.per_particle();
   blocks_.for_each([&](std::size_t q) {
     const auto* nodes = st.nodes(q);
     const auto* w = st.weights(q);
-    const double m = vol[q] * n_l_[q] * materials_[material_[q]].water_density;
-    for (int k = 0; k < K; ++k) node_mass_[nodes[k]] += w[k] * m;
+    const double pores = vol[q] * phi[q] * materials_[material_[q]].water_density;
+    for (int k = 0; k < K; ++k) {
+      node_mass_[nodes[k]] += w[k] * pores * (n_l_[q] / phi[q]);
+      pore_mass[nodes[k]] += w[k] * pores;
+    }
+  });
+  parallel_for(node_mass_.size(), [&](std::size_t i) {
+    if (node_mass_[i] <= kWetFraction * pore_mass[i]) node_mass_[i] = 0.0;
   });
   // Boundary pressures at the step's start (a time function moves them between steps).
   set_boundary_pressures(time_);
@@ -274,6 +344,7 @@ void HydraulicPhysics::correct() {
     }
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
+  account_boundary_inflow();
 }
 
 /// Particle pressure from the nodes (the grid holds the state while particles stand still).
@@ -288,13 +359,19 @@ void HydraulicPhysics::map_to_particles() {
 std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
   saved_scalars_.push_back(double(preconditioner_updates_));
-  return {{"scalars", &saved_scalars_}, {"step_iterations", &step_iterations_}, {"step_residuals", &step_residuals_}};
+  saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0});
+  return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
+          {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
+          {"temperature_at_step_start", &T_prev_}};
 }
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 5) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 5");
+  if (s.size() != 8) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 8");
   preconditioner_updates_ = long(s[4]);
+  source_volume_ = s[5];
+  boundary_inflow_ = s[6];
+  primed_ = s[7] != 0;
   solves_ = long(s[0]);
   iterations_total_ = long(s[1]);
   iterations_max_ = long(s[2]);
@@ -311,7 +388,9 @@ std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const
           {"hydraulic.linear_iterations_mean", solves_ ? double(iterations_total_) / double(solves_) : 0.0},
           {"hydraulic.relative_residual_max", residual_max_},
           {"hydraulic.preconditioner_updates", double(preconditioner_updates_)},
-          {"hydraulic.solve_seconds", solve_seconds_}};
+          {"hydraulic.solve_seconds", solve_seconds_},
+          {"hydraulic.source_volume", source_volume_},
+          {"hydraulic.boundary_inflow_volume", boundary_inflow_}};
 }
 
 FROSTMPM_REGISTER(Physics, HydraulicPhysics)

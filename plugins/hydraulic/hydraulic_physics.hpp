@@ -72,11 +72,15 @@ class HydraulicPhysics final : public Physics {
     std::vector<double> areas;
     TimeFunction value;  ///< inflow Darcy flux [m/s]
     std::string label;
+    double applied = 0;  ///< inflow rate of the current step [m³/s per m]
   };
   struct MaterialModels {
     std::shared_ptr<AbsolutePermeabilityModel> absolute;
     std::shared_ptr<RelativePermeabilityModel> relative;  ///< none: k_r = 1
     double water_density = 1000, compressibility = 0;
+    double zeta = 0;                                   ///< 1 − ρ_c/ρ_l: water volume lost per unit of ice melted
+    double solid_expansion = 0, water_expansion = 0, ice_expansion = 0;  ///< β_s, β_l, β_c [1/K]
+    double stabilization = 0;                          ///< τ / (2G); 0 for a rigid skeleton (G → ∞)
   };
 
   // ---- configuration
@@ -92,11 +96,20 @@ class HydraulicPhysics final : public Physics {
   // ---- particles: per-step coefficients
   std::vector<std::uint16_t> material_;
   std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
+  // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
+  // and T over the last completed step (kept per particle: S_prev_, T_prev_)
+  std::vector<double> source_, S_prev_, T_prev_;
+  bool primed_ = false;        ///< S_prev_ and T_prev_ hold a step's start
+  bool temperature_ = false;   ///< a thermal physics provides the particle temperature
 
   // ---- grid (the kernel's node fields pore_pressure and pressure_increment) and the lumped
   // liquid mass (a node no wet particle touches has none and no pressure unknown)
   std::vector<double>*p_ = nullptr, *dp_ = nullptr;
   std::vector<double> node_mass_, rhs_;
+  std::vector<double> node_storage_, node_source_;  ///< Σ_p S_ip V_p n_l c_w and Σ_p S_ip V_p source_p
+  // Polynomial pressure projection (Eqs. 66–67): per grid cell, ∫ τ/(2G) over its material
+  std::vector<double> cell_stabilization_;
+  bool stabilized_ = false;
   ColouredBlocks<kDim> blocks_;
   std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
   bool grid_valid_ = false;
@@ -113,6 +126,8 @@ class HydraulicPhysics final : public Physics {
   double time_ = 0, dt_ = 0;
   long solves_ = 0, iterations_total_ = 0, iterations_max_ = 0;
   double residual_max_ = 0, solve_seconds_ = 0;
+  double source_volume_ = 0;    ///< water volume the phase change and thermal expansion removed [m³ per m]
+  double boundary_inflow_ = 0;  ///< water volume that entered through pressure and flux boundaries
   std::vector<double> saved_scalars_;
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
@@ -122,6 +137,13 @@ class HydraulicPhysics final : public Physics {
   /// Nodal pressure = the boundary values at t on every pressure boundary.
   void set_boundary_pressures(double t);
   void update_coefficients();
+  /// The volume source of every particle over the step that just ended; primes on the first call.
+  void update_source();
+  /// Adds (τ/2G) ∫ (S − ΠS)ᵀ(S − ΠS) dV / Δt of every cell with material to the matrix (Eq. 67).
+  void add_stabilization();
+  /// Water that entered through the boundaries in this step: the residual of the mass balance
+  /// on the nodes whose pressure is prescribed, plus the prescribed fluxes.
+  void account_boundary_inflow();
   void project_to_grid();
   void map_to_grid();
   void predict();

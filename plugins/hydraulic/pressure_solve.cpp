@@ -1,8 +1,12 @@
 // The pressure Poisson equation of the fractional step (paper Eq. 56, fixed skeleton):
-//   (M / Δt + K) Δp = Σ_p V_p n_l ∇S_ip · v*_p + ∫ S_i q̂ dS,
+//   ((M + H) / Δt + K) Δp = Σ_p V_p n_l ∇S_ip · v*_p − Σ_p S_ip V_p s_p + ∫ S_i q̂ dS,
 //   M_ii = Σ_p V_p n_l c_w S_ip (lumped), K_ij = Σ_p V_p Δt η_p ∇S_ip · ∇S_jp,
+//   s_p = (ζ φ ∂S_l/∂T − β_m) Ṫ the phase-change and thermal-expansion source (update_source),
+//   H the polynomial pressure projection τ/(2G) ∫ (S − ΠS)ᵀ(S − ΠS) dV (Eq. 67, add_stabilization),
 // with Δp = p̂(t + Δt) − p_i on pressure boundaries (rows and columns eliminated, so A stays
 // symmetric positive definite for CG) and Δp = 0 on nodes no wet particle touches.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -28,7 +32,8 @@ void HydraulicPhysics::assemble() {
   }
   values_.assign(graph_.nonzeros(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
-  std::vector<double> node_storage(nodes, 0.0);
+  std::fill(node_storage_.begin(), node_storage_.end(), 0.0);
+  std::fill(node_source_.begin(), node_source_.end(), 0.0);
   const int K = st.per_particle();
   const auto v_star = sim_->particles().field("liquid_velocity_predicted");
   blocks_.for_each([&](std::size_t q) {
@@ -40,7 +45,8 @@ void HydraulicPhysics::assemble() {
     const double* v = v_star.data() + q * kDim;
     const double flux = vol[q] * n_l_[q];
     for (int a = 0; a < K; ++a) {
-      node_storage[n[a]] += w[a] * vol[q] * storage_[q];
+      node_storage_[n[a]] += w[a] * vol[q] * storage_[q];
+      node_source_[n[a]] += w[a] * vol[q] * source_[q];
       double divergence = 0;
       for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * v[d];
       rhs_[n[a]] += flux * divergence;
@@ -52,8 +58,12 @@ void HydraulicPhysics::assemble() {
       }
     }
   });
-  for (std::size_t i = 0; i < nodes; ++i) values_[graph_.diagonal[i]] += node_storage[i] / dt_;
-  for (const auto& bc : flux_bcs_) {
+  for (std::size_t i = 0; i < nodes; ++i) {
+    values_[graph_.diagonal[i]] += node_storage_[i] / dt_;
+    rhs_[i] -= node_source_[i];
+  }
+  if (stabilized_) add_stabilization();
+  for (auto& bc : flux_bcs_) {
     const double q = bc.value(time_ + dt_);
     if (!std::isfinite(q)) {
       std::ostringstream msg;
@@ -61,7 +71,11 @@ void HydraulicPhysics::assemble() {
           << time_ + dt_ << " s, step " << sim_->step() << "; check the value's table or expression";
       throw NumericalBlowUp(msg.str());
     }
-    for (std::size_t j = 0; j < bc.nodes.size(); ++j) rhs_[bc.nodes[j]] += q * bc.areas[j];
+    bc.applied = 0;
+    for (std::size_t j = 0; j < bc.nodes.size(); ++j) {
+      rhs_[bc.nodes[j]] += q * bc.areas[j];
+      bc.applied += q * bc.areas[j];
+    }
   }
 
   // Fixed rows: pressure boundaries (Δp prescribed) and dry or empty nodes (Δp = 0). Their
@@ -93,6 +107,90 @@ void HydraulicPhysics::assemble() {
     values_[graph_.diagonal[i]] = 1.0;
     rhs_[i] = dp[i];
   }
+}
+
+namespace {
+/// ∫ (S − ΠS)ᵀ(S − ΠS) dA of a bilinear cell of area A, in units of A / 144, nodes counter-
+/// clockwise: the consistent mass A/36 (4 2 1 2) minus the cell average (A/16 everywhere).
+// Integrated exactly per cell, not at the particles: at a cell's centre (one particle per
+// cell) a checkerboard mode has S − ΠS = 0 and would escape the projection.
+constexpr double kProjection[4][4] = {{7, -1, -5, -1}, {-1, 7, -1, -5}, {-5, -1, 7, -1}, {-1, -5, -1, 7}};
+
+/// The four nodes of cell `c`, counter-clockwise from the lower left.
+std::array<std::size_t, 4> cell_nodes(const UniformGrid<kDim>& grid, std::size_t c) {
+  const int i = static_cast<int>(c % static_cast<std::size_t>(grid.cells[0]));
+  const int j = static_cast<int>(c / static_cast<std::size_t>(grid.cells[0]));
+  return {grid.node_index({i, j}), grid.node_index({i + 1, j}), grid.node_index({i + 1, j + 1}),
+          grid.node_index({i, j + 1})};
+}
+}  // namespace
+
+/// H = Σ_cells τ/(2G) ∫ (S − ΠS)ᵀ(S − ΠS) dV (Eq. 67), each cell weighted by the volume of its
+/// particles (a cell the material half fills gets half), added as H / Δt: the paper's
+/// H_stab (p^{k+1} − p^k) read as a rate, like M33 — τ/(2G) is a compressibility, so only
+/// H Δp/Δt has the units of the other terms (docs/architecture.md).
+void HydraulicPhysics::add_stabilization() {
+  const auto& grid = sim_->grid();
+  const auto x = sim_->particles().field("position");
+  const auto vol = sim_->particles().field("volume");
+  std::fill(cell_stabilization_.begin(), cell_stabilization_.end(), 0.0);
+  for (std::size_t q = 0; q < vol.size(); ++q) {
+    const double weight = vol[q] * materials_[material_[q]].stabilization;
+    if (weight == 0) continue;
+    std::size_t c = 0, stride = 1;
+    for (int d = 0; d < kDim; ++d) {
+      const int i = std::clamp(static_cast<int>(std::floor((x[q * kDim + d] - grid.origin[d]) / grid.spacing[d])), 0,
+                               grid.cells[d] - 1);
+      c += static_cast<std::size_t>(i) * stride;
+      stride *= static_cast<std::size_t>(grid.cells[d]);
+    }
+    cell_stabilization_[c] += weight;
+  }
+  for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
+    const double w = cell_stabilization_[c] / (144.0 * dt_);
+    if (w == 0) continue;
+    const auto n = cell_nodes(grid, c);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) values_[graph_.position(n[a], static_cast<int>(n[b]))] += w * kProjection[a][b];
+  }
+}
+
+/// inflow_i = ((M + H) Δp)_i / Δt + Σ_p S_ip V_p s_p − Σ_p V_p ∇S_ip · q_p on the nodes of
+/// pressure boundaries (the row of the mass balance their prescribed pressure replaced), plus
+/// the prescribed fluxes: an independent check of the water the run took in.
+void HydraulicPhysics::account_boundary_inflow() {
+  const auto& st = sim_->stencil();
+  const std::size_t nodes = node_mass_.size();
+  std::vector<char> on_boundary(nodes, 0);
+  for (const auto& bc : pressure_bcs_)
+    for (const auto i : bc.nodes) on_boundary[i] = 1;
+  std::vector<double> balance(nodes, 0.0);
+  const auto vol = sim_->particles().field("volume");
+  const auto q = sim_->particles().field("water_flux");
+  const int K = st.per_particle();
+  blocks_.for_each([&](std::size_t p) {
+    const auto* n = st.nodes(p);
+    const auto* g = st.gradients(p);
+    for (int a = 0; a < K; ++a) {
+      double divergence = 0;
+      for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * q[p * kDim + d];
+      balance[n[a]] -= vol[p] * divergence;
+    }
+  });
+  const auto& dp = *dp_;
+  for (std::size_t i = 0; i < nodes; ++i) balance[i] += node_storage_[i] * dp[i] / dt_ + node_source_[i];
+  for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
+    const double w = cell_stabilization_[c] / (144.0 * dt_);
+    if (w == 0) continue;
+    const auto n = cell_nodes(sim_->grid(), c);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) balance[n[a]] += w * kProjection[a][b] * dp[n[b]];
+  }
+  double inflow = 0;
+  for (std::size_t i = 0; i < nodes; ++i)
+    if (on_boundary[i]) inflow += balance[i];
+  for (const auto& bc : flux_bcs_) inflow += bc.applied;
+  boundary_inflow_ += dt_ * inflow;
 }
 
 void HydraulicPhysics::solve_pressure() {

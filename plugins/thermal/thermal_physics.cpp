@@ -399,7 +399,7 @@ void ThermalPhysics::map_to_particles() {
   long clipped = 0, shedding = 0;
   double max_diffusivity = 0, min_capacity = std::numeric_limits<double>::infinity();
 #pragma omp parallel for schedule(static) reduction(+ : clipped, shedding) reduction(max : max_diffusivity) \
-    reduction(min : min_capacity)
+    reduction(min : min_capacity) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
