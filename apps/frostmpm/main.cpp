@@ -14,6 +14,7 @@
 #include "frostmpm/config/input_error.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/checkpoint.hpp"
+#include "frostmpm/io/log.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/simulation.hpp"
@@ -82,7 +83,9 @@ std::unique_ptr<PreparedScene> prepare(const SceneSource& source, const std::str
   PluginSetup setup{source.plugin_paths};
   setup.load_defaults(*prepared->loader);
   setup.load_scene_paths(*prepared->loader, root);
-  for (const auto& warning : refusal_warnings(*prepared->loader)) std::cerr << "warning: " << warning << "\n";
+  for (const auto& warning : refusal_warnings(*prepared->loader)) log::warning(warning);
+  for (const auto& p : prepared->loader->loaded())
+    log::debug("plugin " + p.name + " " + p.version + " from " + p.file);
 
   std::vector<std::string> task_names;
   for (const auto& [name, _] : app::tasks()) task_names.push_back(name);
@@ -144,13 +147,13 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
   const std::string dir =
       restart ? restart_dir : out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
   OutputDir out(dir);
+  log::debug("task '" + prepared->task_name + "' on " + std::to_string(thread_count()) + " thread(s), output in " + dir);
   std::optional<RunInterrupted> interrupted;
   try {
     const InterruptGuard stop_cleanly_on_sigint_and_sigterm;
     prepared->task->execute(out, app::RunRequest{source, restart});
   } catch (const NumericalBlowUp& e) {
-    std::cerr << "error: " << e.what() << "; the frames written before it in " << dir
-              << " stay readable\n";
+    log::error(std::string(e.what()) + "; the frames written before it in " + dir + " stay readable");
     return kBlowUpExitCode;
   } catch (const RunInterrupted& e) {
     interrupted = e;
@@ -172,12 +175,13 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");
   if (interrupted) {
-    std::cerr << std::setprecision(10) << "interrupted at t = " << interrupted->time << " s (step "
-              << interrupted->step << "); resume with: " << shell_word(program) << " run --restart "
-              << shell_word(dir) << "\n";
+    std::ostringstream message;
+    message << std::setprecision(10) << "interrupted at t = " << interrupted->time << " s (step " << interrupted->step
+            << "); resume with: " << shell_word(program) << " run --restart " << shell_word(dir);
+    log::write(log::Level::warning, message.str());
     return 128 + interrupted->signal;
   }
-  std::cout << "frostmpm: task '" << prepared->task_name << "' finished; results in " << dir << "\n";
+  log::info("frostmpm: task '" + prepared->task_name + "' finished; results in " + dir);
   return 0;
 }
 
@@ -213,6 +217,10 @@ int main(int argc, char** argv) {
                   "OpenMP threads for particle and node loops (default: OMP_NUM_THREADS, else every core); "
                   "results do not depend on it")
       ->check(CLI::Range(1, 1024));
+  bool quiet = false, verbose = false;
+  auto* quiet_flag = run->add_flag("-q,--quiet", quiet, "print warnings and errors only (no progress or info lines)");
+  run->add_flag("-v,--verbose", verbose, "also print debug lines (plugins loaded, threads, output folder)")
+      ->excludes(quiet_flag);
 
   auto* check = cli.add_subcommand("check", "validate a scene and print it with defaults filled in");
   add_scene_options(check, check_options, /*scene_required=*/true);
@@ -240,6 +248,8 @@ int main(int argc, char** argv) {
   try {
     if (*run) {
       if (threads > 0) omp_set_num_threads(threads);
+      if (quiet) log::set_level(log::Level::warning);
+      if (verbose) log::set_level(log::Level::debug);
       return cmd_run(run_options, out_dir, restart_dir, argv[0]);
     }
     if (*check) return cmd_check(check_options);
