@@ -1,4 +1,5 @@
 // The `frostmpm` command: run, check, plugins, describe.
+#include <charconv>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -34,9 +35,14 @@ struct SceneOptions {
 
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_required) {
   cmd->add_option("scene", o.scene, "scene file (YAML)")->required(scene_required);
-  cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value")
+  // One value per --set / --plugin-path (repeat the option), so the scene may come before or
+  // after them.
+  cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value (repeatable)")
+      ->allow_extra_args(false)
       ->take_all();
-  cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)");
+  cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 }
 
 /// The scene as given on the command line, in the form a checkpoint keeps: absolute paths, so
@@ -77,6 +83,7 @@ std::unique_ptr<PreparedScene> prepare(const SceneSource& source, const std::str
   YAML::Node tree = file_root.raw();
   for (const auto& assignment : source.overrides) apply_override(tree, assignment);
   prepared->root = std::make_unique<ConfigNode>(tree, scene_name);
+  prepared->root->set_overrides(source.overrides);
   const ConfigNode& root = *prepared->root;
 
   prepared->loader = std::make_unique<PluginLoader>(prepared->registry);
@@ -125,6 +132,10 @@ nlohmann::json to_json(const YAML::Node& node) {
       const std::string& text = node.Scalar();
       double number = 0;
       bool flag = false;
+      // Whole numbers (counts, steps, sample numbers) stay JSON integers: 601, not 601.0.
+      long long whole = 0;
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), whole);
+      if (node.Tag() != "!" && !text.empty() && ec == std::errc() && end == text.data() + text.size()) return whole;
       if (node.Tag() != "!" && YAML::convert<double>::decode(node, number)) return number;
       if (node.Tag() != "!" && YAML::convert<bool>::decode(node, flag)) return flag;
       return text;
@@ -227,7 +238,9 @@ int main(int argc, char** argv) {
 
   std::vector<std::string> list_paths;
   auto* plugins = cli.add_subcommand("plugins", "list every registered model by kind, with library and version");
-  plugins->add_option("--plugin-path", list_paths, "extra plugin folder or library (repeatable)");
+  plugins->add_option("--plugin-path", list_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 
   std::string describe_target;
   bool markdown = false;
@@ -236,7 +249,9 @@ int main(int argc, char** argv) {
   describe->add_option("target", describe_target, "KIND/NAME (e.g. sfcc/exponential), KIND, or 'all'")
       ->required();
   describe->add_flag("--markdown", markdown, "print Markdown (used to generate docs/config-reference.md)");
-  describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)");
+  describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 
   try {
     cli.parse(argc, argv);

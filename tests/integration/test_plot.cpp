@@ -12,7 +12,12 @@ using namespace frostmpm::test;
 
 namespace {
 
-bool have_matplotlib() { return run_command("/usr/bin/python3 -c 'import matplotlib, numpy, h5py'").exit_code == 0; }
+/// False (with a warning: the test is skipped) when /usr/bin/python3 cannot plot.
+bool have_matplotlib() {
+  if (run_command("/usr/bin/python3 -c 'import matplotlib, numpy, h5py'").exit_code == 0) return true;
+  WARN("skipped: /usr/bin/python3 lacks matplotlib, numpy or h5py");
+  return false;
+}
 
 /// Checks `path` is a PNG file (signature) of non-trivial size.
 void require_png(const std::string& path) {
@@ -26,10 +31,7 @@ void require_png(const std::string& path) {
 }  // namespace
 
 TEST_CASE("plot.py draws the metrics and the fields of a run", "[plot]") {
-  if (!have_matplotlib()) {
-    WARN("skipped: /usr/bin/python3 lacks matplotlib, numpy or h5py");
-    return;
-  }
+  if (!have_matplotlib()) return;
   TempDir dir;
   const std::string out = dir.file("out");
   const auto run = run_frostmpm("run " + source_dir() + "/configs/tutorials/frozen_inclusion.yaml -o " + out +
@@ -45,10 +47,7 @@ TEST_CASE("plot.py draws the metrics and the fields of a run", "[plot]") {
 }
 
 TEST_CASE("plot.py draws the freezing curves into another folder with --to", "[plot]") {
-  if (!have_matplotlib()) {
-    WARN("skipped: /usr/bin/python3 lacks matplotlib, numpy or h5py");
-    return;
-  }
+  if (!have_matplotlib()) return;
   TempDir dir;
   const std::string out = dir.file("out");
   REQUIRE(run_frostmpm("run " + source_dir() + "/configs/tutorials/freezing_curves.yaml -o " + out).exit_code == 0);
