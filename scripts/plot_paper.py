@@ -10,34 +10,19 @@ left), with the 13 INTERFROST codes' thaw-time ranges shaded (VERIFICATION §3).
 talik: temperature at the centre point A and the equivalent hydraulic conductivity k_eq(t)
 (Fig. 10, right). contours: temperature contours of one frame of fields.h5 with the 0 °C isotherm
 (Figs. 3 and 7); the last frame unless --frame. Each OUT is a run folder (metrics.csv, fields.h5).
-Needs matplotlib, numpy, scipy and h5py (Debian's /usr/bin/python3).
+Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
+scripts/plot.py.
 """
 import argparse
-import csv
 import os
 import sys
 
-try:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-    from scipy.interpolate import griddata
-except ImportError as error:  # pragma: no cover - depends on the machine
-    sys.exit(f"plot_paper.py: {error}; run it with Debian's /usr/bin/python3 (python3-matplotlib, python3-scipy)")
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import read_fields  # noqa: E402
+import frostplot  # noqa: E402
+from frostplot import metrics, np, plt  # noqa: E402
 
 INTERFROST_H = [(32.4, 41.7), (18.1, 20.7), (10.8, 12.8)]  # thaw time, cases 1–3 (0, 3, 9 %)
 LABELS = ["case 1 (0 %)", "case 2 (3 %)", "case 3 (9 %)"]
-
-
-def metrics(folder):
-    with open(os.path.join(folder, "metrics.csv")) as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
 
 
 def two_panels(folders, left, right):
@@ -65,34 +50,22 @@ def inclusion(folders, png):
     b.axhline(1.0710, color="k", lw=0.5, ls=":")
     b.axhline(1.1100, color="k", lw=0.5, ls=":")
     b.set(xlabel="t [h]", ylabel="liquid water volume [m³ per m]", title="V_l (dotted: 1.0710, 1.1100)")
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    frostplot.save(fig, png)
 
 
 def talik(folders, png):
     fig, a, b, _ = two_panels(folders, "T_center", "k_eq_m_per_s")
     a.set(xlabel="t [h]", ylabel="T at A (0.5, 0.5) [°C]", title="temperature at the centre")
     b.set(xlabel="t [h]", ylabel="k_eq [m/s]", title="equivalent hydraulic conductivity at the outlet")
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    frostplot.save(fig, png)
 
 
 def contours(folder, png, frame):
-    frames = read_fields.read_frames(folder)
-    fr = frames[frame]
-    x, y = fr["coordinates"][:, 0], fr["coordinates"][:, 1]
-    T = fr["fields"]["temperature"]
-    xi = np.linspace(x.min(), x.max(), 400)
-    yi = np.linspace(y.min(), y.max(), max(50, int(400 * (y.max() - y.min()) / (x.max() - x.min()))))
-    X, Y = np.meshgrid(xi, yi)
-    Z = griddata((x, y), T, (X, Y), method="linear")
-    fig, ax = plt.subplots(figsize=(9, 9 * (y.max() - y.min()) / (x.max() - x.min()) + 1))
-    c = ax.contourf(X, Y, Z, levels=np.linspace(-5, 5, 21), cmap="coolwarm", extend="both")
-    ax.contour(X, Y, Z, levels=[0.0], colors="k", linewidths=1)
-    fig.colorbar(c, ax=ax, label="T [°C]")
-    ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]", title=f"{folder}: t = {fr['time']:.0f} s (black: 0 °C)")
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
+    fr = frostplot.read_fields.read_frames(folder)[frame]
+    fig, ax = plt.subplots(figsize=(9, 9 * frostplot.aspect(fr) + 1))
+    frostplot.field_panel(ax, fig, fr, "temperature", levels=np.linspace(-5, 5, 21), zero_line=True, label="T [°C]")
+    ax.set(title=f"{folder}: t = {fr['time']:.0f} s (black: 0 °C)")
+    frostplot.save(fig, png)
 
 
 def main():

@@ -1,11 +1,10 @@
 // `task: freezing_curves` — evaluates a material's SFCC and permeability models over a
-// temperature range and writes a CSV table and a PNG plot: the calibration check an engineer
-// makes before a run.
+// temperature range and writes a CSV table: the calibration check an engineer makes before a
+// run. `/usr/bin/python3 scripts/plot.py OUT` draws the curves from the table.
 #include <cmath>
 #include <iomanip>
 #include <vector>
 
-#include "frostmpm/io/png_plot.hpp"
 #include "frostmpm/models/permeability_model.hpp"
 #include "frostmpm/models/sfcc_model.hpp"
 #include "frostmpm/scene/model_section.hpp"
@@ -25,7 +24,7 @@ ParamSchema range_schema() {
   s.reals("temperature_range", "degC", "[T_min, T_max] of the table").size(2);
   s.integer("samples", "number of temperatures (evenly spaced)").defaults_to(241L).at_least(2).at_most(1000000);
   s.real("pore_pressure", "Pa", "liquid pressure p_l at which S_l is evaluated").defaults_to(0.0);
-  s.string("output", "base name of the CSV and PNG files").defaults_to("freezing_curves");
+  s.string("output", "base name of the CSV file").defaults_to("freezing_curves");
   return s;
 }
 
@@ -82,15 +81,6 @@ class FreezingCurvesTask final : public Task {
         os << T[i] << ',' << S[i] << ',' << dSdT[i] << ',' << dSdp[i] << ',' << kr[i] << ',' << dkr[i]
            << ',' << ka[i] << ',' << ka[i] * kr[i] << '\n';
     });
-
-    PlotFigure figure;
-    figure.title = "Freezing curves: " + sfcc_.entry->name + " + " + relative_.entry->name;
-    figure.panels.push_back({"Liquid saturation", "T [degC]", "S_l [-]", {{"S_l", T, S}}});
-    figure.panels.push_back({"Slope of the SFCC", "T [degC]", "dS_l/dT [1/degC]", {{"dS_l/dT", T, dSdT}}});
-    PlotPanel k_panel{"Relative hydraulic conductivity", "T [degC]", "k_r [-] (log)", {{"k_r", T, kr}}};
-    k_panel.log_y = true;
-    figure.panels.push_back(k_panel);
-    write_png_plot(out.file(base + ".png"), figure);
   }
 
  private:

@@ -1,4 +1,5 @@
 // The `frostmpm` command: run, check, plugins, describe.
+#include <charconv>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -14,6 +15,7 @@
 #include "frostmpm/config/input_error.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/checkpoint.hpp"
+#include "frostmpm/io/log.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/simulation.hpp"
@@ -33,9 +35,14 @@ struct SceneOptions {
 
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_required) {
   cmd->add_option("scene", o.scene, "scene file (YAML)")->required(scene_required);
-  cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value")
+  // One value per --set / --plugin-path (repeat the option), so the scene may come before or
+  // after them.
+  cmd->add_option("--set", o.overrides, "override a scene value by its YAML path: path.to.key=value (repeatable)")
+      ->allow_extra_args(false)
       ->take_all();
-  cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)");
+  cmd->add_option("--plugin-path", o.plugin_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 }
 
 /// The scene as given on the command line, in the form a checkpoint keeps: absolute paths, so
@@ -76,13 +83,16 @@ std::unique_ptr<PreparedScene> prepare(const SceneSource& source, const std::str
   YAML::Node tree = file_root.raw();
   for (const auto& assignment : source.overrides) apply_override(tree, assignment);
   prepared->root = std::make_unique<ConfigNode>(tree, scene_name);
+  prepared->root->set_overrides(source.overrides);
   const ConfigNode& root = *prepared->root;
 
   prepared->loader = std::make_unique<PluginLoader>(prepared->registry);
   PluginSetup setup{source.plugin_paths};
   setup.load_defaults(*prepared->loader);
   setup.load_scene_paths(*prepared->loader, root);
-  for (const auto& warning : refusal_warnings(*prepared->loader)) std::cerr << "warning: " << warning << "\n";
+  for (const auto& warning : refusal_warnings(*prepared->loader)) log::warning(warning);
+  for (const auto& p : prepared->loader->loaded())
+    log::debug("plugin " + p.name + " " + p.version + " from " + p.file);
 
   std::vector<std::string> task_names;
   for (const auto& [name, _] : app::tasks()) task_names.push_back(name);
@@ -122,6 +132,10 @@ nlohmann::json to_json(const YAML::Node& node) {
       const std::string& text = node.Scalar();
       double number = 0;
       bool flag = false;
+      // Whole numbers (counts, steps, sample numbers) stay JSON integers: 601, not 601.0.
+      long long whole = 0;
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), whole);
+      if (node.Tag() != "!" && !text.empty() && ec == std::errc() && end == text.data() + text.size()) return whole;
       if (node.Tag() != "!" && YAML::convert<double>::decode(node, number)) return number;
       if (node.Tag() != "!" && YAML::convert<bool>::decode(node, flag)) return flag;
       return text;
@@ -144,13 +158,13 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
   const std::string dir =
       restart ? restart_dir : out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
   OutputDir out(dir);
+  log::debug("task '" + prepared->task_name + "' on " + std::to_string(thread_count()) + " thread(s), output in " + dir);
   std::optional<RunInterrupted> interrupted;
   try {
     const InterruptGuard stop_cleanly_on_sigint_and_sigterm;
     prepared->task->execute(out, app::RunRequest{source, restart});
   } catch (const NumericalBlowUp& e) {
-    std::cerr << "error: " << e.what() << "; the frames written before it in " << dir
-              << " stay readable\n";
+    log::error(std::string(e.what()) + "; the frames written before it in " + dir + " stay readable");
     return kBlowUpExitCode;
   } catch (const RunInterrupted& e) {
     interrupted = e;
@@ -172,12 +186,13 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");
   if (interrupted) {
-    std::cerr << std::setprecision(10) << "interrupted at t = " << interrupted->time << " s (step "
-              << interrupted->step << "); resume with: " << shell_word(program) << " run --restart "
-              << shell_word(dir) << "\n";
+    std::ostringstream message;
+    message << std::setprecision(10) << "interrupted at t = " << interrupted->time << " s (step " << interrupted->step
+            << "); resume with: " << shell_word(program) << " run --restart " << shell_word(dir);
+    log::write(log::Level::warning, message.str());
     return 128 + interrupted->signal;
   }
-  std::cout << "frostmpm: task '" << prepared->task_name << "' finished; results in " << dir << "\n";
+  log::info("frostmpm: task '" + prepared->task_name + "' finished; results in " + dir);
   return 0;
 }
 
@@ -213,13 +228,19 @@ int main(int argc, char** argv) {
                   "OpenMP threads for particle and node loops (default: OMP_NUM_THREADS, else every core); "
                   "results do not depend on it")
       ->check(CLI::Range(1, 1024));
+  bool quiet = false, verbose = false;
+  auto* quiet_flag = run->add_flag("-q,--quiet", quiet, "print warnings and errors only (no progress or info lines)");
+  run->add_flag("-v,--verbose", verbose, "also print debug lines (plugins loaded, threads, output folder)")
+      ->excludes(quiet_flag);
 
   auto* check = cli.add_subcommand("check", "validate a scene and print it with defaults filled in");
   add_scene_options(check, check_options, /*scene_required=*/true);
 
   std::vector<std::string> list_paths;
   auto* plugins = cli.add_subcommand("plugins", "list every registered model by kind, with library and version");
-  plugins->add_option("--plugin-path", list_paths, "extra plugin folder or library (repeatable)");
+  plugins->add_option("--plugin-path", list_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 
   std::string describe_target;
   bool markdown = false;
@@ -228,7 +249,9 @@ int main(int argc, char** argv) {
   describe->add_option("target", describe_target, "KIND/NAME (e.g. sfcc/exponential), KIND, or 'all'")
       ->required();
   describe->add_flag("--markdown", markdown, "print Markdown (used to generate docs/config-reference.md)");
-  describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)");
+  describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
 
   try {
     cli.parse(argc, argv);
@@ -240,6 +263,8 @@ int main(int argc, char** argv) {
   try {
     if (*run) {
       if (threads > 0) omp_set_num_threads(threads);
+      if (quiet) log::set_level(log::Level::warning);
+      if (verbose) log::set_level(log::Level::debug);
       return cmd_run(run_options, out_dir, restart_dir, argv[0]);
     }
     if (*check) return cmd_check(check_options);

@@ -1,5 +1,7 @@
 #include "reference.hpp"
 
+#include <algorithm>
+#include <array>
 #include <iomanip>
 #include <iostream>
 
@@ -26,11 +28,22 @@ void describe_text(const RegistryEntry& e, std::ostream& out) {
   out << e.kind << "/" << e.name << " — " << e.doc << "\n";
   out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
   out << "  YAML: " << scene_form(e) << "\n";
-  for (const auto& p : e.schema.params()) {
-    out << "  " << std::left << std::setw(22) << p.name << std::setw(14) << to_string(p.type)
-        << std::setw(10) << (p.unit.empty() ? "-" : p.unit) << std::setw(16) << p.default_text();
-    const std::string range = p.type == ParamType::Choice ? "one of: " + join(p.choices) : p.range_text();
-    out << std::setw(16) << range << " " << p.doc << "\n";
+  // One row per parameter: name, type, unit, default, allowed range, doc; the columns as wide
+  // as their widest entry (UTF-8 aware: units like °C), two spaces apart.
+  std::vector<std::array<std::string, 6>> rows;
+  for (const auto& p : e.schema.params())
+    rows.push_back({p.name, to_string(p.type), p.unit.empty() ? "-" : p.unit, p.default_text(),
+                    p.type == ParamType::Choice ? "one of: " + join(p.choices) : p.range_text(), p.doc});
+  const auto width = [](const std::string& s) {
+    return static_cast<std::size_t>(std::count_if(s.begin(), s.end(), [](char c) { return (c & 0xC0) != 0x80; }));
+  };
+  std::array<std::size_t, 5> widths{};
+  for (const auto& row : rows)
+    for (std::size_t c = 0; c < widths.size(); ++c) widths[c] = std::max(widths[c], width(row[c]));
+  for (const auto& row : rows) {
+    out << " ";
+    for (std::size_t c = 0; c < widths.size(); ++c) out << " " << row[c] << std::string(widths[c] - width(row[c]) + 1, ' ');
+    out << " " << row[5] << "\n";
   }
 }
 

@@ -1,8 +1,9 @@
 // `task: simulation` — a material point simulation: the kernel plus the scene's physics.
 #include <sys/resource.h>
 
-#include <iostream>
+#include <sstream>
 
+#include "frostmpm/io/log.hpp"
 #include "frostmpm/simulation/simulation.hpp"
 #include "task.hpp"
 
@@ -26,9 +27,12 @@ class SimulationTask final : public Task {
     // in run.json.
     for (const auto& physics : sim_.physics())
       for (const auto& [key, value] : physics->statistics())
-        if (key.find("unconverged") != std::string::npos && value > 0)
-          std::cerr << "warning: " << key << " = " << value << " of " << sim_.statistics().steps
-                    << " steps (see run.json; a smaller time.dt or a looser tolerance helps)\n";
+        if (key.find("unconverged") != std::string::npos && value > 0) {
+          std::ostringstream message;
+          message << key << " = " << value << " of " << sim_.statistics().steps
+                  << " steps (see run.json; a smaller time.dt or a looser tolerance helps)";
+          log::warning(message.str());
+        }
   }
 
   YAML::Node summary() const override {

@@ -41,7 +41,23 @@ ConfigNode ConfigNode::load_string(const std::string& text, const std::string& n
   }
 }
 
+void ConfigNode::set_overrides(std::vector<std::string> assignments) {
+  overrides_ = std::make_shared<const std::vector<std::string>>(std::move(assignments));
+}
+
+ConfigNode ConfigNode::with(YAML::Node node, std::string path) const {
+  ConfigNode out(std::move(node), file_, std::move(path));
+  out.overrides_ = overrides_;
+  return out;
+}
+
 SourceLocation ConfigNode::where() const {
+  // The last override whose path is this node or one of its parents gave this node's value.
+  if (overrides_)
+    for (auto it = overrides_->rbegin(); it != overrides_->rend(); ++it) {
+      const std::string target = it->substr(0, it->find('='));
+      if (path_ == target || path_.rfind(target + ".", 0) == 0) return SourceLocation{"--set " + *it, path_, 0, 0};
+    }
   SourceLocation loc{file_, path_, 0, 0};
   if (node_ && node_.Mark().line >= 0 && !node_.Mark().is_null()) {
     loc.line = node_.Mark().line + 1;
@@ -73,7 +89,7 @@ ConfigNode ConfigNode::child(const std::string& key) const {
     throw InputError(loc, "missing required key '" + key + "'");
   }
   consumed_->insert(key);
-  return ConfigNode(c, file_, child_path(key));
+  return with(c, child_path(key));
 }
 
 std::optional<ConfigNode> ConfigNode::optional_child(const std::string& key) const {
@@ -111,7 +127,7 @@ std::vector<ConfigNode> ConfigNode::elements() const {
   if (!node_.IsSequence()) throw error("expected a list");
   std::vector<ConfigNode> out;
   std::size_t i = 0;
-  for (const auto& item : node_) out.emplace_back(item, file_, child_path(std::to_string(i++)));
+  for (const auto& item : node_) out.push_back(with(item, child_path(std::to_string(i++))));
   return out;
 }
 
@@ -196,7 +212,12 @@ void apply_override(YAML::Node& root, const std::string& assignment) {
   }
   if (!node.IsMap() && !node.IsSequence())
     throw InputError("--set " + path + ": '" + walked + "' is a value, not a section");
-  YAML::Node parsed = YAML::Load(value);
+  YAML::Node parsed;
+  try {
+    parsed = YAML::Load(value);
+  } catch (const YAML::Exception& e) {
+    throw InputError("--set " + assignment + ": the value is not valid YAML: " + e.msg);
+  }
   if (node.IsSequence()) {
     char* end = nullptr;
     const long index = std::strtol(parts.back().c_str(), &end, 10);

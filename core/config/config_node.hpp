@@ -23,6 +23,11 @@ class ConfigNode {
   static std::string read_file(const std::string& file);
   static ConfigNode load_string(const std::string& text, const std::string& name = "<string>");
 
+  /// The `--set PATH=VALUE` assignments applied to this tree (apply_override), in order:
+  /// errors in a value that came from one name it ("--set time.dt=abc: at 'time.dt': ...")
+  /// instead of a line of the scene file. Children inherit them.
+  void set_overrides(std::vector<std::string> assignments);
+
   const std::string& path() const { return path_; }
   const std::string& file() const { return file_; }
   SourceLocation where() const;
@@ -61,6 +66,9 @@ class ConfigNode {
   std::string file_;
   std::string path_;
   std::shared_ptr<std::set<std::string>> consumed_;
+  std::shared_ptr<const std::vector<std::string>> overrides_;
+
+  ConfigNode with(YAML::Node node, std::string path) const;  ///< a child sharing file and overrides
   std::string child_path(const std::string& key) const;
 };
 

@@ -1,5 +1,6 @@
 #include "frostmpm/config/param_schema.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <sstream>
 
@@ -24,6 +25,14 @@ std::string number_text(double v) {
   os << v;
   return os.str();
 }
+/// Shortest text that reads back as the same double ("1e-12", "0.6", "86400"); YAML's .inf
+/// and .nan for the rest.
+YAML::Node real_node(double v) {
+  if (!std::isfinite(v)) return YAML::Node(v);
+  char buf[32];
+  const auto result = std::to_chars(buf, buf + sizeof(buf), v);
+  return YAML::Node(std::string(buf, result.ptr));
+}
 }  // namespace
 
 YAML::Node to_yaml(const ParamValue& value) {
@@ -33,8 +42,10 @@ YAML::Node to_yaml(const ParamValue& value) {
         using T = std::decay_t<decltype(v)>;
         if constexpr (std::is_same_v<T, std::vector<double>>) {
           node = YAML::Node(YAML::NodeType::Sequence);
-          for (double x : v) node.push_back(x);
+          for (double x : v) node.push_back(real_node(x));
           node.SetStyle(YAML::EmitterStyle::Flow);
+        } else if constexpr (std::is_same_v<T, double>) {
+          node = real_node(v);
         } else {
           node = v;
         }

@@ -1,30 +1,36 @@
 #pragma once
-// A small math expression compiler for scene input ("5 + 2*sin(2*pi*t/86400)").
+// Math expressions in scene input ("5 + 2*sin(2*pi*t/86400)"), parsed and evaluated by
+// muparser (https://beltoforion.de/en/muparser/), restricted to the names below.
 //
-// The text is parsed once into postfix bytecode (constant sub-expressions folded, constant
-// operands fused into the instruction that uses them) and evaluated with a fixed-size stack on
-// the C stack: evaluation does no allocation and no string work, and is thread-safe.
-//
-// Grammar, loosest binding first:
-//   comparison  a < b, a > b, a <= b, a >= b     (left-assoc; result 1 or 0)
+// Syntax, loosest binding first:
+//   c ? a : b                                    (a when c != 0, else b)
+//   a || b, a && b                               (logical; result 1 or 0)
+//   comparison  a < b, a > b, a <= b, a >= b, a == b, a != b   (result 1 or 0)
 //   additive    a + b, a - b                     (left-assoc)
 //   product     a * b, a / b                     (left-assoc)
 //   unary       -a, +a                           (binds weaker than ^: -2^2 = -4)
 //   power       a ^ b                            (right-assoc: 2^3^2 = 512; 2^-1 = 0.5)
 //   primary     number, variable, constant (pi, e), function(args), (expr)
-// Functions: sin cos tan exp log log10 sqrt abs floor ceil step(x) (1 for x >= 0, else 0),
-// min(a,b) max(a,b) pow(a,b) if(c,a,b) (a when c != 0, else b; both are evaluated).
+// Functions: sin cos tan exp log (natural) log10 sqrt abs floor ceil step(x) (1 for x >= 0,
+// else 0), min(a,b) max(a,b) pow(a,b) if(c,a,b) (a when c != 0, else b; both are evaluated).
 // Math follows <cmath>: a domain error (log(-1), sqrt(-1)) gives NaN, 1/0 gives inf.
+// Differences from the hand-written parser FrostMPM had before (muparser's rules): a doubled sign
+// ("--3", "2*--t") is an error, write -(-3); == != && || and ?: are accepted; an expression
+// is constant only when it names no variable (if(1, 3, t) is evaluated each time).
+//
+// Evaluation is thread-safe: each thread evaluates with its own muparser instance, created on
+// its first evaluate() of the expression; after that evaluate() does no allocation. A constant
+// expression is folded to a number when compiled and evaluate() just returns it.
 #include <cstddef>
-#include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace frostmpm {
 
-/// Malformed expression. what() is "<detail> at column N"; the column is 1-based in the
-/// expression text (text length + 1 means "at the end").
+/// Malformed expression. what() and detail() are "<what is wrong> at column N[; hint]"; the
+/// column is 1-based in the expression text (text length + 1 means "at the end").
 class ExpressionError : public std::runtime_error {
  public:
   ExpressionError(const std::string& detail, std::size_t column);
@@ -38,9 +44,6 @@ class ExpressionError : public std::runtime_error {
 
 class Expression {
  public:
-  /// Upper bound of the evaluation stack; deeper expressions are rejected when compiled.
-  static constexpr std::size_t kMaxStack = 128;
-
   /// The constant 0.
   Expression();
 
@@ -58,40 +61,27 @@ class Expression {
   /// Value for an expression of (at most) one variable.
   double operator()(double x) const { return evaluate(&x); }
 
-  /// True when the value depends on no variable (the whole expression folded to a number).
+  /// True when the expression names no variable (its value was computed when compiled).
   bool is_constant() const { return constant_; }
   /// The folded value when is_constant().
   double constant_value() const { return value_; }
 
   const std::string& text() const { return text_; }
   const std::vector<std::string>& variables() const { return variables_; }
-  /// Number of bytecode instructions (1 for a folded constant).
-  std::size_t size() const { return code_.empty() ? 1 : code_.size(); }
-  /// Stack slots evaluation needs.
-  std::size_t stack_depth() const { return depth_; }
-  /// The bytecode, one instruction per line, for debugging ("push t", "mulk 6.28", ...).
-  std::string disassemble() const;
 
   static const std::vector<std::string>& constant_names();  ///< pi, e
   static const std::vector<std::string>& function_names();  ///< sin, cos, ...
 
-  /// Bytecode instruction (public only so the implementation's helpers can name it).
-  struct Instr {
-    std::uint8_t op;
-    std::uint32_t index;  ///< variable index for a variable push
-    double value;         ///< constant operand (pushes and the fused "k" forms)
-  };
+  struct Shared;  ///< the muparser instances, one per evaluating thread (implementation detail)
 
  private:
   std::string text_;
   std::vector<std::string> variables_;
-  std::vector<Instr> code_;
-  std::size_t depth_ = 1;
   bool constant_ = true;
   double value_ = 0;
+  std::shared_ptr<Shared> shared_;  ///< null for a constant
 
   double run(const double* values) const;
-  friend class ExpressionCompiler;
 };
 
 }  // namespace frostmpm

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "frostmpm/io/log.hpp"
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
@@ -603,9 +604,11 @@ double Simulation::plan_step(const LoopState& loop) const {
     const double limit = physics_[i]->stable_time_step();
     // A fixed step above a physics' stability limit is cut to it; say so once.
     if (fixed_dt_ > 0 && limit < fixed_dt_ * (1 - 1e-12) && !warned_dt_cut_) {
-      std::cerr << "warning: time.dt = " << fixed_dt_ << " s exceeds the stability limit of physics '"
-                << physics_keys_[i] << "' (" << limit << " s at t = " << time_
-                << " s); the run takes the smaller step (an implicit scheme takes any step)\n";
+      std::ostringstream message;
+      message << "time.dt = " << fixed_dt_ << " s exceeds the stability limit of physics '" << physics_keys_[i]
+              << "' (" << limit << " s at t = " << time_
+              << " s); the run takes the smaller step (an implicit scheme takes any step)";
+      log::warning(message.str());
       warned_dt_cut_ = true;
     }
     dt = std::min(dt, limit);
@@ -665,8 +668,7 @@ namespace {
 /// fields.h5 of the run being restarted, cut back to the frames its checkpoint knows.
 ParticleFieldWriter reopen_fields(const OutputDir& out, long frames) {
   if (!std::filesystem::exists(out.file("fields.h5"))) {
-    std::cerr << "warning: " << out.file("fields.h5") << " is missing; a new one holds the frames after the "
-              << "checkpoint\n";
+    log::warning(out.file("fields.h5") + " is missing; a new one holds the frames after the checkpoint");
     return ParticleFieldWriter(out.path(), kDim);
   }
   try {
@@ -766,13 +768,15 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
       loop.next_output = output_every_ > 0 ? std::min(loop.next_output + output_every_, end_time_) : end_time_;
       if (loop.next_output <= time_ + eps) loop.next_output = end_time_ + 1;
     }
-    if (options.progress && std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
+    if (options.progress && log::enabled(log::Level::info) &&
+        std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
       last_print = Clock::now();
       const double wall = std::chrono::duration<double>(last_print - wall_start).count();
       const double eta = wall * (end_time_ - time_) / std::max(time_ - time_start, 1e-300);
-      std::cerr << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
-                << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s\n"
-                << std::defaultfloat;
+      std::ostringstream line;
+      line << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
+           << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
+      log::info(line.str());
     }
     if (time_ >= end_time_ - eps) break;
 
