@@ -18,14 +18,12 @@ std::string to_string(ParamType type) {
   return "?";
 }
 
-namespace {
-std::string number_text(double v) {
+std::string number_text(double v, int precision) {
   std::ostringstream os;
-  os.precision(12);
+  os.precision(precision);
   os << v;
   return os.str();
 }
-}  // namespace
 
 YAML::Node to_yaml(const ParamValue& value) {
   YAML::Node node;

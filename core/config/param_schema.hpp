@@ -111,4 +111,7 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
 
 YAML::Node to_yaml(const ParamValue& value);
 
+/// A number as messages print it: shortest form, `precision` significant digits.
+std::string number_text(double v, int precision = 12);
+
 }  // namespace frostmpm

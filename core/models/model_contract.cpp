@@ -5,18 +5,12 @@
 #include <functional>
 #include <limits>
 #include <span>
-#include <sstream>
 
 namespace frostmpm {
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
-}
+std::string num(double v) { return number_text(v, 6); }
 
 std::vector<double> linspace(double a, double b, std::size_t n) {
   std::vector<double> out(std::max<std::size_t>(n, 2));

@@ -25,16 +25,14 @@ std::string line_with(const std::string& text, const std::string& part) {
   return text.substr(begin, text.find('\n', at) - begin);
 }
 
-const std::string kScene = R"(task: freezing_curves
-material:
-  porosity: 0.3
-  sfcc: {model: van_genuchten_cc, lambda: 0.5, p0: 1.0e5}
-  relative_permeability: {model: van_genuchten_mualem, m: 0.5}
-  absolute_permeability: {model: constant, k0: 1.0e-7}
-freezing_curves:
-  temperature_range: [-5.0, 1.0]
-  samples: 7
-)";
+const std::string& kScene = kFreezingCurvesScene;
+
+/// `frostmpm check` of the freezing-curves scene with extra arguments.
+CommandResult check_scene(const std::string& extra) {
+  TempDir dir;
+  write_file(dir.file("scene.yaml"), kScene);
+  return run_frostmpm("check " + dir.file("scene.yaml") + " " + extra);
+}
 
 }  // namespace
 
@@ -56,17 +54,6 @@ TEST_CASE("plugins lists good plugins and every refused library with its reason,
   CHECK(has(bad_default, "default 1 of parameter 'residual_saturation' is outside its own range [0, 1)"));
   CHECK(!has(r.output, "bad_default  "));  // nothing of a refused library stays registered
   CHECK(has(line_with(r.output, "libfixture_not_a_plugin.so"), "not a FrostMPM plugin"));
-}
-
-TEST_CASE("a scene needing only good plugins runs beside refused libraries", "[plugins]") {
-  TempDir dir;
-  write_file(dir.file("scene.yaml"), "plugin_paths: [" + fixtures() + "]\n" + kScene);
-  const auto r = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + dir.file("out"));
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  CHECK(has(line_with(r.output, "libfixture_unresolved_symbol.so"), "warning: "));
-  CHECK(has(line_with(r.output, "libfixture_stale_abi.so"), "warning: "));
-  REQUIRE(fs::exists(dir.file("out/freezing_curves.csv")));
 }
 
 TEST_CASE("a library named directly that cannot load is one error line", "[plugins][bad-input]") {
@@ -99,9 +86,7 @@ TEST_CASE("a plugin folder that does not exist is a warning", "[plugins]") {
 }
 
 TEST_CASE("an unknown model names the registered ones and the plugin folders searched", "[plugins][bad-input]") {
-  TempDir dir;
-  write_file(dir.file("scene.yaml"), kScene);
-  const auto r = run_frostmpm("check " + dir.file("scene.yaml") + " --set material.sfcc.model=painter_karra");
+  const auto r = check_scene("--set material.sfcc.model=painter_karra");
   INFO(r.output);
   REQUIRE(r.exit_code == 2);
   CHECK(has(r.output, "unknown sfcc model 'painter_karra'"));
@@ -110,16 +95,13 @@ TEST_CASE("an unknown model names the registered ones and the plugin folders sea
 }
 
 TEST_CASE("swapping only the model name names the old model's parameters and the one-line swap", "[plugins][bad-input]") {
-  TempDir dir;
-  write_file(dir.file("scene.yaml"), kScene);
-  auto r = run_frostmpm("check " + dir.file("scene.yaml") + " --set material.sfcc.model=exponential");
+  auto r = check_scene("--set material.sfcc.model=exponential");
   INFO(r.output);
   REQUIRE(r.exit_code == 2);
   CHECK(has(r.output, "sfcc model 'exponential' does not take lambda (of van_genuchten_cc), p0 (of van_genuchten_cc)"));
   CHECK(has(r.output, "it takes: width, residual_saturation, freezing_point"));
   CHECK(has(r.output, "--set 'material.sfcc={model: exponential, ...}'"));
-  r = run_frostmpm("check " + dir.file("scene.yaml") +
-                   " --set 'material.sfcc={model: exponential, width: 0.5, residual_saturation: 0.05}'");
+  r = check_scene("--set 'material.sfcc={model: exponential, width: 0.5, residual_saturation: 0.05}'");
   CHECK(r.exit_code == 0);
 }
 
