@@ -1,4 +1,4 @@
-// The `frostmpm` command: run, check, plugins, describe.
+// The `frostmpm` command: run, check, plugins, describe, test-model.
 #include <charconv>
 #include <chrono>
 #include <filesystem>
@@ -21,6 +21,7 @@
 #include "frostmpm/simulation/simulation.hpp"
 #include "reference.hpp"
 #include "task.hpp"
+#include "test_model.hpp"
 
 namespace fs = std::filesystem;
 using namespace frostmpm;
@@ -253,6 +254,24 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false)
       ->take_all();
 
+  app::TestModelOptions test_model_options;
+  auto* test_model = cli.add_subcommand(
+      "test-model", "check a model's contract by sampling it (bounds, monotonicity, derivatives, continuity); "
+                    "exit 1 with one line per violation");
+  test_model->add_option("target", test_model_options.target, "KIND/NAME, e.g. sfcc/exponential")->required();
+  test_model->add_option("--set", test_model_options.settings,
+                         "a model parameter: name=value (repeatable; required ones not given are picked inside their range)")
+      ->allow_extra_args(false)
+      ->take_all();
+  test_model->add_option("--plugin-path", test_model_options.plugin_paths, "extra plugin folder or library (repeatable)")
+      ->allow_extra_args(false)
+      ->take_all();
+  test_model->add_option("--temperature-range", test_model_options.temperature_range,
+                         "SFCC: sampled temperatures LO HI in degC (default: freezing point -10 to +2)")
+      ->expected(2);
+  test_model->add_option("--samples", test_model_options.samples, "sample points (default 2001)")
+      ->check(CLI::Range(2, 10000000));
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -270,6 +289,7 @@ int main(int argc, char** argv) {
     if (*check) return cmd_check(check_options);
     if (*plugins) return app::cmd_plugins(list_paths, std::cout);
     if (*describe) return app::cmd_describe(describe_target, markdown, describe_paths, std::cout);
+    if (*test_model) return app::cmd_test_model(test_model_options, std::cout);
   } catch (const InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kInputErrorExitCode;

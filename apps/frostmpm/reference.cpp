@@ -69,6 +69,7 @@ int cmd_plugins(const std::vector<std::string>& extra_paths, std::ostream& out) 
       out << "  " << std::left << std::setw(24) << e->name << std::setw(10) << e->version << e->library << "\n";
   }
   for (const auto& r : loaded.loader.refused()) out << "refused: " << r.file << ": " << r.reason << "\n";
+  for (const auto& w : loaded.loader.warnings()) out << "warning: " << w << "\n";
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "frostmpm/config/param_schema.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -18,13 +19,14 @@ std::string to_string(ParamType type) {
   return "?";
 }
 
-namespace {
-std::string number_text(double v) {
+std::string number_text(double v, int precision) {
   std::ostringstream os;
-  os.precision(12);
+  os.precision(precision);
   os << v;
   return os.str();
 }
+
+namespace {
 /// Shortest text that reads back as the same double ("1e-12", "0.6", "86400"); YAML's .inf
 /// and .nan for the rest.
 YAML::Node real_node(double v) {
@@ -75,6 +77,12 @@ ParamSpec& ParamSpec::defaults_to(std::vector<double> values) {
   if (type != ParamType::RealList) throw std::logic_error("parameter '" + name + "' is not a list");
   default_value = std::move(values);
   return *this;
+}
+
+bool ParamSpec::in_range(double v) const {
+  const bool low_bad = lower && (lower_open ? v <= *lower : v < *lower);
+  const bool high_bad = upper && (upper_open ? v >= *upper : v > *upper);
+  return !low_bad && !high_bad && !std::isnan(v);
 }
 
 std::string ParamSpec::range_text() const {
@@ -133,6 +141,24 @@ std::vector<std::string> ParamSchema::names() const {
   return out;
 }
 
+void ParamSchema::check_defaults(const std::string& owner) const {
+  for (const auto& p : params_) {
+    if (!p.default_value) continue;
+    std::vector<double> numbers;
+    if (const auto* v = std::get_if<double>(&*p.default_value)) numbers = {*v};
+    if (const auto* v = std::get_if<long>(&*p.default_value)) numbers = {static_cast<double>(*v)};
+    if (const auto* v = std::get_if<std::vector<double>>(&*p.default_value)) numbers = *v;
+    const bool numbers_ok = std::all_of(numbers.begin(), numbers.end(), [&](double x) { return p.in_range(x); });
+    const bool choice_ok = p.type != ParamType::Choice ||
+                           std::find(p.choices.begin(), p.choices.end(), std::get<std::string>(*p.default_value)) !=
+                               p.choices.end();
+    if (!numbers_ok || !choice_ok)
+      throw InputError(owner + ": the default " + p.default_text() + " of parameter '" + p.name +
+                       "' is outside its own range " +
+                       (p.type == ParamType::Choice ? "{" + join(p.choices) + "}" : p.range_text()));
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 
 const ParamValue& ParamSet::get(const std::string& name) const {
@@ -175,9 +201,7 @@ YAML::Node ParamSet::to_yaml() const {
 namespace {
 
 void check_range(const ParamSpec& spec, double v, const ConfigNode& node) {
-  const bool low_bad = spec.lower && (spec.lower_open ? v <= *spec.lower : v < *spec.lower);
-  const bool high_bad = spec.upper && (spec.upper_open ? v >= *spec.upper : v > *spec.upper);
-  if (low_bad || high_bad) {
+  if (!spec.in_range(v)) {
     std::string message = "value " + number_text(v) + " is out of range; allowed " + spec.range_text();
     if (!spec.unit.empty()) message += " " + spec.unit;
     throw node.error(message);

@@ -48,6 +48,8 @@ struct ParamSpec {
   ParamSpec& below(double v) { upper = v; upper_open = true; return *this; }
   ParamSpec& size(std::size_t n) { list_size = n; return *this; }
 
+  /// Whether `v` lies within the declared bounds (always, when unbounded).
+  bool in_range(double v) const;
   /// "(0, 1]" style text for docs and messages; "" when unbounded.
   std::string range_text() const;
   /// Default as YAML text, or "required".
@@ -66,6 +68,10 @@ class ParamSchema {
   const std::vector<ParamSpec>& params() const { return params_; }
   const ParamSpec* find(const std::string& name) const;
   std::vector<std::string> names() const;
+  /// Throws an InputError for the first default outside its own parameter's range (or not one
+  /// of its choices), naming `owner` (e.g. "sfcc model 'x'"), the parameter, default and range.
+  /// Checked at registration: the fluent setters may give the default before the bounds.
+  void check_defaults(const std::string& owner) const;
 
  private:
   ParamSpec& add(ParamSpec spec);
@@ -104,5 +110,8 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
                       const std::vector<std::string>& also_allowed = {});
 
 YAML::Node to_yaml(const ParamValue& value);
+
+/// A number as messages print it: shortest form, `precision` significant digits.
+std::string number_text(double v, int precision = 12);
 
 }  // namespace frostmpm

@@ -9,12 +9,15 @@
 
 #include <boost/dll/alias.hpp>
 
+#include "frostmpm/plugin/abi_tag.hpp"
 #include "frostmpm/plugin/registry.hpp"
 
 namespace frostmpm {
 
-/// Bumped whenever an interface in core/ changes layout or virtual table.
-inline constexpr const char* kKernelAbiTag = "frostmpm-abi-2";
+/// "frostmpm-abi-<hash>": a hash of the kernel headers a plugin compiles against (comments and
+/// whitespace aside), generated at build time (cmake/FrostMPMAbiTag.cmake). A plugin built
+/// against headers that differ in anything else carries another tag and is refused.
+inline constexpr const char* kKernelAbiTag = FROSTMPM_ABI_TAG;
 
 struct PluginInfo {
   const char* name;

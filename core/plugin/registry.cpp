@@ -1,5 +1,7 @@
 #include "frostmpm/plugin/registry.hpp"
 
+#include <algorithm>
+
 namespace frostmpm {
 
 void Registry::add(RegistryEntry entry) {
@@ -9,6 +11,15 @@ void Registry::add(RegistryEntry entry) {
     throw InputError("duplicate " + entry.kind + " name '" + entry.name + "': registered by " +
                      it->second.library + " and again by " + entry.library);
   by_name.emplace(entry.name, std::move(entry));
+}
+
+void Registry::remove_library(const std::string& library) {
+  for (auto& [kind, by_name] : kinds_)
+    std::erase_if(by_name, [&](const auto& item) { return item.second.library == library; });
+}
+
+void Registry::note_searched(const std::string& folder) {
+  if (std::find(searched_.begin(), searched_.end(), folder) == searched_.end()) searched_.push_back(folder);
 }
 
 const RegistryEntry* Registry::find(const std::string& kind, const std::string& name) const {
@@ -26,6 +37,7 @@ const RegistryEntry& Registry::get(const std::string& kind, const std::string& n
   const std::string hint = closest_match(name, valid);
   if (!hint.empty()) message += "; did you mean '" + hint + "'?";
   message += " Registered: " + (valid.empty() ? std::string("(none; is the plugin path right?)") : join(valid));
+  message += ". Plugin folders searched: " + (searched_.empty() ? std::string("(none)") : join(searched_));
   throw InputError(where, message);
 }
 
@@ -52,6 +64,7 @@ std::vector<const RegistryEntry*> Registry::entries(const std::string& kind) con
 }
 
 void Registrar::add_entry(RegistryEntry entry) {
+  entry.schema.check_defaults(entry.kind + " model '" + entry.name + "'");
   entry.library = library_;
   entry.plugin = plugin_;
   entry.version = version_;

@@ -29,9 +29,15 @@ class Registry {
  public:
   /// Adds an entry; a second entry with the same kind and name is an InputError naming both.
   void add(RegistryEntry entry);
+  /// Drops every entry that came from `library` (a plugin refused half-way through registering).
+  void remove_library(const std::string& library);
+  /// Records a plugin folder the loader searched, for the unknown-name message.
+  void note_searched(const std::string& folder);
+  const std::vector<std::string>& searched() const { return searched_; }
 
   const RegistryEntry* find(const std::string& kind, const std::string& name) const;
-  /// Like find, but an unknown name is an InputError at `where` listing the registered names.
+  /// Like find, but an unknown name is an InputError at `where` listing the registered names
+  /// and the plugin folders searched.
   const RegistryEntry& get(const std::string& kind, const std::string& name,
                            const SourceLocation& where) const;
   std::vector<std::string> kinds() const;
@@ -55,6 +61,7 @@ class Registry {
 
  private:
   std::map<std::string, std::map<std::string, RegistryEntry>> kinds_;
+  std::vector<std::string> searched_;
 };
 
 /// Handed to a plugin's register entry point; stamps entries with the library they came from.
@@ -81,6 +88,8 @@ class Registrar {
     add_entry(std::move(entry));
   }
 
+  /// Stamps and adds an entry; a schema whose default lies outside its own range is an
+  /// InputError naming the model, the parameter, the default and the range.
   void add_entry(RegistryEntry entry);
 
  private:

@@ -38,7 +38,7 @@ void PluginSetup::load_scene_paths(PluginLoader& loader, const ConfigNode& scene
 }
 
 std::vector<std::string> refusal_warnings(const PluginLoader& loader) {
-  std::vector<std::string> out;
+  std::vector<std::string> out = loader.warnings();
   for (const auto& r : loader.refused()) out.push_back(r.file + ": refused: " + r.reason);
   return out;
 }

@@ -18,7 +18,7 @@ struct PluginSetup {
   void load_scene_paths(PluginLoader& loader, const ConfigNode& scene_root) const;
 };
 
-/// One-line warnings for every refused library (file: reason).
+/// One-line warnings: plugin folders that do not exist, then every refused library (file: reason).
 std::vector<std::string> refusal_warnings(const PluginLoader& loader);
 
 }  // namespace frostmpm

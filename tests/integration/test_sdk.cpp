@@ -26,10 +26,11 @@ TEST_CASE("an out-of-tree SFCC plugin builds against the installed SDK and runs"
   // Configure with the SDK prefix only; the template's source is copied so nothing from the
   // FrostMPM tree (include paths, targets) can leak in.
   fs::copy(source_dir() + "/examples/plugin-template", dir.file("template"), fs::copy_options::recursive);
-  r = run_command("cmake -S " + dir.file("template") + " -B " + plugin_build +
-                  " -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=" + prefix);
+  // No CMAKE_BUILD_TYPE: the SDK makes it Release, so a plugin is optimised by default.
+  r = run_command("cmake -S " + dir.file("template") + " -B " + plugin_build + " -DCMAKE_PREFIX_PATH=" + prefix);
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
+  REQUIRE(read_file(plugin_build + "/CMakeCache.txt").find("CMAKE_BUILD_TYPE:STRING=Release") != std::string::npos);
   r = run_command("cmake --build " + plugin_build + " -j 2");
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
@@ -40,6 +41,12 @@ TEST_CASE("an out-of-tree SFCC plugin builds against the installed SDK and runs"
   INFO(r.output);
   REQUIRE(r.output.find("exponential_decay") != std::string::npos);
   REQUIRE(r.output.find("libmy_sfcc.so") != std::string::npos);
+
+  // The author's contract check passes for the template's model.
+  r = run_command(env + frostmpm_exe() + " test-model sfcc/exponential_decay");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(r.output.find("sfcc/exponential_decay: contract kept") != std::string::npos);
 
   r = run_command(env + frostmpm_exe() + " run " + dir.file("template/scene.yaml") + " -o " + dir.file("out"));
   INFO(r.output);

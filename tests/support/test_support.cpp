@@ -27,6 +27,20 @@ const Registry& builtin_registry() {
   return registry;
 }
 
+const std::string kFreezingCurvesScene = R"(task: freezing_curves
+material:
+  porosity: 0.3
+  sfcc:
+    model: van_genuchten_cc
+    lambda: 0.5
+    p0: 1.0e5
+  relative_permeability: {model: van_genuchten_mualem, m: 0.5}
+  absolute_permeability: {model: constant, k0: 1.0e-7}
+freezing_curves:
+  temperature_range: [-5.0, 1.0]
+  samples: 7
+)";
+
 std::string source_dir() { return FROSTMPM_SOURCE_DIR; }
 std::string binary_dir() { return FROSTMPM_BINARY_DIR; }
 std::string frostmpm_exe() { return binary_dir() + "/bin/frostmpm"; }

@@ -38,6 +38,10 @@ class TempDir {
   std::string path_;
 };
 
+/// A small valid freezing-curves scene (its van Genuchten-CC SFCC on lines 4-7) for
+/// CLI tests to run, break or extend.
+extern const std::string kFreezingCurvesScene;
+
 /// A numeric CSV file with a header line (metrics.csv, freezing_curves.csv).
 struct CsvTable {
   std::vector<std::string> header;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "frostmpm/config/config_node.hpp"
+#include "frostmpm/models/model_contract.hpp"
 #include "frostmpm/models/permeability_model.hpp"
 #include "frostmpm/scene/model_section.hpp"
 #include "numerics.hpp"
@@ -298,4 +299,20 @@ TEST_CASE("constant and intrinsic absolute permeability", "[permeability]") {
   const auto other = make_absolute("intrinsic",
                                    "permeability: 2.0e-12, fluid_density: 1020, gravity: 9.8, fluid_viscosity: 1.0e-3");
   CHECK(absolute(*other, 0.3).k == Approx(1.99920e-5).epsilon(1e-5));
+}
+
+TEST_CASE("every permeability parameter set keeps the contract `frostmpm test-model` checks", "[permeability][contract]") {
+  const auto& registry = frostmpm::test::builtin_registry();
+  for (const auto* entry : registry.entries(RelativePermeabilityModel::kKind))
+    for (const auto& c : relative_cases().at(entry->name)) {
+      const auto violations = frostmpm::check_relative_permeability_contract(*make_relative(entry->name, c.params));
+      INFO(entry->name << " {" << c.params << "}: " << frostmpm::join(violations, "\n"));
+      CHECK(violations.empty());
+    }
+  for (const auto* entry : registry.entries(AbsolutePermeabilityModel::kKind))
+    for (const auto& c : absolute_cases().at(entry->name)) {
+      const auto violations = frostmpm::check_absolute_permeability_contract(*make_absolute(entry->name, c.params));
+      INFO(entry->name << " {" << c.params << "}: " << frostmpm::join(violations, "\n"));
+      CHECK(violations.empty());
+    }
 }

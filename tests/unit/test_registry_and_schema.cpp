@@ -303,6 +303,39 @@ TEST_CASE("Registrar stamps entries with their library", "[config]") {
   CHECK(contains(message, "libother.so"));
 }
 
+TEST_CASE("a schema whose default lies outside its own range is refused at registration", "[config]") {
+  frostmpm::Registry registry;
+  frostmpm::Registrar registrar(registry, "libbad.so", "bad-plugin", "0.1", nullptr);
+  auto entry = fake_entry("sfcc", "bad_default", "");
+  entry.schema.real("residual_saturation", "-", "S_res").defaults_to(1).at_least(0).below(1);
+  const std::string message = input_error_of([&] { registrar.add_entry(entry); });
+  INFO(message);
+  CHECK(message == "sfcc model 'bad_default': the default 1 of parameter 'residual_saturation' is outside its own range [0, 1)");
+  CHECK(registry.find("sfcc", "bad_default") == nullptr);
+
+  frostmpm::ParamSchema choices;
+  choices.choice("solver", {"direct", "cg"}, "solver").defaults_to("gmres");
+  CHECK(contains(input_error_of([&] { choices.check_defaults("physics 'x'"); }), "{direct, cg}"));
+  frostmpm::ParamSchema list;
+  list.reals("origin", "m", "a point").defaults_to(std::vector<double>{0.0, -1.0}).at_least(0);
+  CHECK(contains(input_error_of([&] { list.check_defaults("physics 'x'"); }), "parameter 'origin'"));
+  frostmpm::ParamSchema fine;
+  fine.real("fraction", "-", "a fraction").defaults_to(0.25).at_least(0).at_most(1);
+  CHECK_NOTHROW(fine.check_defaults("sfcc model 'fine'"));
+}
+
+TEST_CASE("a refused library's entries are removed, others stay", "[config]") {
+  frostmpm::Registry registry;
+  frostmpm::Registrar first(registry, "libfirst.so", "first", "1", nullptr);
+  first.add_entry(fake_entry("sfcc", "kept", ""));
+  frostmpm::Registrar second(registry, "libsecond.so", "second", "1", nullptr);
+  second.add_entry(fake_entry("sfcc", "dropped", ""));
+  second.add_entry(fake_entry("relative_permeability", "dropped_too", ""));
+  registry.remove_library("libsecond.so");
+  CHECK(registry.names("sfcc") == std::vector<std::string>{"kept"});
+  CHECK(registry.names("relative_permeability").empty());
+}
+
 // ---- ParamSchema / ParamSet -------------------------------------------------------------------
 
 namespace {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "frostmpm/config/config_node.hpp"
+#include "frostmpm/models/model_contract.hpp"
 #include "frostmpm/models/sfcc_model.hpp"
 #include "frostmpm/scene/model_section.hpp"
 #include "numerics.hpp"
@@ -381,4 +382,16 @@ TEST_CASE("van Genuchten-Clausius-Clapeyron freezing point moves with liquid pre
   CHECK(eval(*model, Tf - 1e-3, 1.0e6).S < 1.0);
   // Suction raises it.
   CHECK(eval(*model, 0.0, -1.0e5).S < 1.0);
+}
+
+TEST_CASE("every SFCC parameter set keeps the contract `frostmpm test-model` checks", "[sfcc][contract]") {
+  const auto& registry = frostmpm::test::builtin_registry();
+  for (const auto* entry : registry.entries(SfccModel::kKind))
+    for (const auto& c : sfcc_cases().at(entry->name)) {
+      const auto model = make_sfcc(entry->name, c.params);
+      const double T_f = model->freezing_point();
+      const auto violations = frostmpm::check_sfcc_contract(*model, T_f - 20.0, T_f + 5.0);
+      INFO(entry->name << " {" << c.params << "}: " << frostmpm::join(violations, "\n"));
+      CHECK(violations.empty());
+    }
 }
