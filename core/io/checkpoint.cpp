@@ -89,9 +89,26 @@ struct CheckpointWriter::Impl {
   hdf5::Handle file;
   bool committed = false;
 
+  /// Runs `fn` after reserving the disk for `data_bytes` in `objects` new groups or datasets.
   template <class F>
-  void guarded(F&& fn) {
-    one_line_errors("cannot write checkpoint " + partial_path + ": ", std::forward<F>(fn));
+  void guarded(std::uintmax_t data_bytes, std::size_t objects, F&& fn) {
+    one_line_errors("cannot write checkpoint " + partial_path + ": ", [&] {
+      if (file.get() < 0) {  // the first call creates the file
+        file = hdf5::create_file(partial_path);
+        hdf5::write_attribute(file.get(), "format", kFormat);
+      }
+      hdf5::reserve(file.get(), partial_path, data_bytes, objects);
+      fn();
+    });
+  }
+
+  /// Closes and removes the unfinished .partial (a failed write leaves nothing behind).
+  void discard() {
+    const hdf5::QuietErrors quiet;
+    file = hdf5::Handle();
+    H5Eclear2(H5E_DEFAULT);
+    std::error_code ec;
+    fs::remove(partial_path, ec);
   }
 };
 
@@ -99,23 +116,23 @@ CheckpointWriter::CheckpointWriter(const std::string& dir) : impl_(std::make_uni
   impl_->dir = dir;
   impl_->final_path = checkpoint_path(dir);
   impl_->partial_path = impl_->final_path + ".partial";
-  impl_->guarded([&] {
-    impl_->file = hdf5::create_file(impl_->partial_path);
-    hdf5::write_attribute(impl_->file.get(), "format", kFormat);
-  });
+  try {
+    impl_->guarded(0, 1, [] {});
+  } catch (...) {
+    impl_->discard();  // the destructor does not run for a constructor that throws
+    throw;
+  }
 }
 
 CheckpointWriter::~CheckpointWriter() {
-  if (impl_->committed) return;
-  const hdf5::QuietErrors quiet;
-  impl_->file = hdf5::Handle();
-  H5Eclear2(H5E_DEFAULT);
-  std::error_code ec;
-  fs::remove(impl_->partial_path, ec);
+  if (!impl_->committed) impl_->discard();
 }
 
 void CheckpointWriter::write(const SceneSource& scene) {
-  impl_->guarded([&] {
+  std::uintmax_t bytes = scene.path.size() + scene.text.size();
+  for (const auto& list : {scene.overrides, scene.plugin_paths})
+    for (const auto& item : list) bytes += item.size() + 16;
+  impl_->guarded(bytes, 5, [&] {
     const hdf5::Handle group = hdf5::create_group(impl_->file.get(), "scene");
     hdf5::write_strings(group.get(), "path", {scene.path});
     hdf5::write_strings(group.get(), "text", {scene.text});
@@ -125,7 +142,7 @@ void CheckpointWriter::write(const SceneSource& scene) {
 }
 
 void CheckpointWriter::write(const LoopState& loop) {
-  impl_->guarded([&] {
+  impl_->guarded(0, 2 + loop.statistics.stage_seconds.size() / 8, [&] {
     const hdf5::Handle group = hdf5::create_group(impl_->file.get(), "loop");
     for (const auto& [name, value] : loop_reals(loop)) hdf5::write_attribute(group.get(), name, *value);
     for (const auto& [name, value] : loop_integers(loop))
@@ -136,7 +153,9 @@ void CheckpointWriter::write(const LoopState& loop) {
 }
 
 void CheckpointWriter::write(const ParticleStore& particles) {
-  impl_->guarded([&] {
+  std::uintmax_t bytes = particles.ranges().size() * 3 * 8;
+  for (const auto& name : particles.field_names()) bytes += particles.field(name).size() * 8;
+  impl_->guarded(bytes, particles.field_names().size() + 3, [&] {
     const hdf5::Handle group = hdf5::create_group(impl_->file.get(), "particles");
     const std::size_t count = particles.size();
     hdf5::write_attribute(group.get(), "count", static_cast<std::int64_t>(count));
@@ -155,7 +174,9 @@ void CheckpointWriter::write(const ParticleStore& particles) {
 }
 
 void CheckpointWriter::write_physics(const std::string& key, const std::vector<PersistentArray>& arrays) {
-  impl_->guarded([&] {
+  std::uintmax_t bytes = 0;
+  for (const auto& array : arrays) bytes += array.values->size() * 8;
+  impl_->guarded(bytes, arrays.size() + 2, [&] {
     const hdf5::Id file = impl_->file.get();
     const hdf5::Handle all = hdf5::exists(file, "physics") ? hdf5::open_group(file, "physics")
                                                            : hdf5::create_group(file, "physics");
@@ -167,9 +188,10 @@ void CheckpointWriter::write_physics(const std::string& key, const std::vector<P
 }
 
 void CheckpointWriter::commit() {
-  impl_->guarded([&] {
+  impl_->guarded(0, 1, [&] {
     if (!hdf5::exists(impl_->file.get(), "physics")) hdf5::create_group(impl_->file.get(), "physics");
     hdf5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_GLOBAL), "flushing");
+    hdf5::reserve(impl_->file.get(), impl_->partial_path, 0, 0);
     impl_->file.close("closing");
     sync_to_disk(impl_->partial_path, O_RDONLY);
     fs::rename(impl_->partial_path, impl_->final_path);

@@ -1,6 +1,11 @@
 #include "frostmpm/io/hdf5_support.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <stdexcept>
 #include <type_traits>
@@ -15,7 +20,14 @@ namespace {
 
 herr_t collect_error(unsigned, const H5E_error2_t* err, void* out) {
   auto& messages = *static_cast<std::vector<std::string>*>(out);
-  if (err && err->desc && *err->desc) messages.emplace_back(err->desc);
+  if (!err || !err->desc || !*err->desc) return 0;
+  // A failed system call (sec2 driver) is a long line of addresses and sizes around
+  // "error message = 'No space left on device'": keep only that text.
+  const std::string desc = err->desc;
+  const std::string marker = "error message = '";
+  const auto at = desc.find(marker);
+  const auto end = at == std::string::npos ? at : desc.find('\'', at + marker.size());
+  messages.push_back(end == std::string::npos ? desc : desc.substr(at + marker.size(), end - at - marker.size()));
   return 0;
 }
 
@@ -98,6 +110,22 @@ void fail(const std::string& what) { throw std::runtime_error(what + " failed: "
 
 void check(int status, const std::string& what) {
   if (status < 0) fail(what);
+}
+
+void reserve(Id file, const std::string& path, std::uintmax_t data_bytes, std::size_t objects) {
+  // Generous: only reserved, the file ends up as large as HDF5 needs.
+  const std::uintmax_t bytes = data_bytes + objects * 2048 + (data_bytes + objects > 0 ? 16 << 10 : 0);
+  hsize_t end = 0;  // where HDF5 allocates next
+  check(H5Fget_filesize(file, &end), "H5Fget_filesize");
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error(std::strerror(errno));
+  const int error = bytes > 0 ? ::posix_fallocate(fd, static_cast<off_t>(end), static_cast<off_t>(bytes)) : 0;
+  if (bytes == 0 || error != 0) {
+    const int cut = ::ftruncate(fd, static_cast<off_t>(end));  // best effort
+    static_cast<void>(cut);
+  }
+  ::close(fd);
+  if (error != 0 && error != EOPNOTSUPP && error != EINVAL) throw std::runtime_error(std::strerror(error));
 }
 
 Handle::Handle(Id id, Closer closer, const std::string& what) : id_(id), closer_(closer) {

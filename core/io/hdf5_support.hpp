@@ -35,6 +35,15 @@ class QuietErrors {
 /// fail(what) when status < 0.
 void check(int status, const std::string& what);
 
+/// Reserves disk after the end of `file` (stored at `path`) for what HDF5 writes next:
+/// `data_bytes` plus room for the headers, B-trees and heaps of `objects` new groups or
+/// datasets. Both 0: cuts off what is left of earlier reservations (call it after a flush). A
+/// full disk (or quota, or file size limit) then fails here with std::runtime_error(the
+/// system's reason) before HDF5 has changed anything: after a failed write HDF5 1.10 may leave
+/// the file's earlier contents damaged, and cannot close it (it crashes at exit). File systems
+/// without preallocation skip the check.
+void reserve(Id file, const std::string& path, std::uintmax_t data_bytes, std::size_t objects);
+
 /// Owns an HDF5 identifier and closes it with `closer` (H5Fclose, H5Gclose, ...).
 class Handle {
  public:

@@ -1,14 +1,80 @@
 #include "frostmpm/io/output_dir.hpp"
 
-#include <filesystem>
-#include <fstream>
+#include <fcntl.h>
 #include <unistd.h>
 
-#include "frostmpm/config/input_error.hpp"
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <utility>
 
 namespace fs = std::filesystem;
 
 namespace frostmpm {
+
+OutputError::OutputError(const std::string& path, const std::string& reason, const std::string& when)
+    : InputError("cannot write " + path + when + ": " + reason) {}
+
+OutputError::~OutputError() = default;
+
+std::string at_step(long step, double time) {
+  std::ostringstream text;
+  text.precision(10);
+  text << " at step " << step << " (t = " << time << " s)";
+  return text.str();
+}
+
+CheckedFile::CheckedFile(std::string path, bool append) : path_(std::move(path)) {
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0666);
+  if (fd_ < 0) throw OutputError(path_, std::strerror(errno));
+}
+
+CheckedFile::~CheckedFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+CheckedFile::CheckedFile(CheckedFile&& other) noexcept
+    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
+
+void CheckedFile::write(std::string_view text, const std::string& when) {
+  const off_t start = ::lseek(fd_, 0, SEEK_END);
+  while (!text.empty()) {
+    const ssize_t n = ::write(fd_, text.data(), text.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : ENOSPC;
+      // A full disk may take part of the piece: cut it off (best effort), so readers never
+      // see half a row.
+      const int cut = start >= 0 ? ::ftruncate(fd_, start) : 0;
+      static_cast<void>(cut);
+      throw OutputError(path_, std::strerror(error), when);
+    }
+    text.remove_prefix(static_cast<std::size_t>(n));
+  }
+}
+
+void CheckedFile::close() {
+  const int fd = std::exchange(fd_, -1);
+  if (fd >= 0 && ::close(fd) != 0) throw OutputError(path_, std::strerror(errno));
+}
+
+void write_file_atomically(const std::string& path, std::string_view text, const std::string& when) {
+  const std::string temp_path = path + ".partial";
+  try {
+    CheckedFile out(temp_path, /*append=*/false);
+    out.write(text, when);
+    out.close();
+    std::error_code ec;
+    fs::rename(temp_path, path, ec);
+    if (ec) throw OutputError(path, ec.message(), when);
+  } catch (const OutputError&) {
+    std::error_code ignored;
+    fs::remove(temp_path, ignored);  // no empty or cut-short .partial left behind
+    throw;
+  }
+}
 
 OutputDir::OutputDir(std::string path) : path_(std::move(path)) {
   std::error_code ec;
@@ -28,20 +94,13 @@ OutputDir::OutputDir(std::string path) : path_(std::move(path)) {
 }
 
 void OutputDir::write_text(const std::string& name, const std::function<void(std::ostream&)>& writer) const {
-  const std::string final_path = file(name);
-  const std::string temp_path = final_path + ".partial";
-  {
-    std::ofstream out(temp_path);
-    if (!out) throw InputError("cannot write '" + final_path + "'");
-    writer(out);
-    out.flush();
-    if (!out) throw InputError("failed while writing '" + final_path + "' (disk full?)");
-  }
-  fs::rename(temp_path, final_path);
+  std::ostringstream text;
+  writer(text);
+  write_file_atomically(file(name), text.str());
 }
 
 void OutputDir::write_text(const std::string& name, const std::string& text) const {
-  write_text(name, [&](std::ostream& out) { out << text; });
+  write_file_atomically(file(name), text);
 }
 
 }  // namespace frostmpm

@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -17,6 +16,7 @@
 #include <utility>
 
 #include "frostmpm/io/hdf5_support.hpp"
+#include "frostmpm/io/output_dir.hpp"
 
 namespace frostmpm {
 
@@ -158,27 +158,30 @@ struct ParticleFieldWriter::Impl {
 
   void flush() const { hdf5::check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flushing " + h5_path()); }
 
-  void write_xdmf() const {
-    const std::string final_path = xdmf_path();
-    const std::string partial_path = final_path + ".partial";
-    {
-      std::ofstream out(partial_path, std::ios::binary | std::ios::trunc);
-      out << "<?xml version=\"1.0\" ?>\n"
-             "<Xdmf Version=\"3.0\">\n"
-             "  <Domain>\n"
-             "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n"
-          << xdmf_grids
-          << "    </Grid>\n"
-             "  </Domain>\n"
-             "</Xdmf>\n";
-      out.close();
-      if (!out) throw std::runtime_error("ParticleFieldWriter: cannot write " + partial_path);
-    }
-    std::error_code ec;
-    std::filesystem::rename(partial_path, final_path, ec);
-    if (ec) {
-      throw std::runtime_error("ParticleFieldWriter: cannot rename " + partial_path + " to " + final_path + ": " +
-                               ec.message());
+  void write_xdmf(const std::string& when = "") const {
+    write_file_atomically(xdmf_path(),
+                          "<?xml version=\"1.0\" ?>\n"
+                          "<Xdmf Version=\"3.0\">\n"
+                          "  <Domain>\n"
+                          "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" +
+                              xdmf_grids +
+                              "    </Grid>\n"
+                              "  </Domain>\n"
+                              "</Xdmf>\n",
+                          when);
+  }
+
+  /// Runs `fn` (HDF5 work on fields.h5); a failure becomes one OutputError line naming the file.
+  template <class F>
+  void guarded(const std::string& when, F&& fn) {
+    const hdf5::QuietErrors quiet;
+    try {
+      fn();
+    } catch (const OutputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      H5Eclear2(H5E_DEFAULT);
+      throw OutputError(h5_path(), e.what(), when);
     }
   }
 
@@ -241,12 +244,13 @@ ParticleFieldWriter::ParticleFieldWriter(const std::string& dir, int dim) {
   std::filesystem::create_directories(impl_->dir, ec);
   if (ec) throw std::runtime_error("ParticleFieldWriter: cannot create folder " + impl_->dir + ": " + ec.message());
 
-  const hdf5::QuietErrors quiet;
   // Readers (ParaView, scripts/read_fields.py) may open the file while the run is going on, so
   // it is created without HDF5 file locking.
-  impl_->file = hdf5::create_file(impl_->h5_path());
-  hdf5::write_attribute(impl_->file.get(), "dim", dim);
-  impl_->flush();
+  impl_->guarded("", [&] {
+    impl_->file = hdf5::create_file(impl_->h5_path());
+    hdf5::write_attribute(impl_->file.get(), "dim", dim);
+    impl_->flush();
+  });
   // Replace any fields.xdmf of an earlier run at once: it would point into the truncated file.
   impl_->write_xdmf();
 }
@@ -318,20 +322,28 @@ void ParticleFieldWriter::write(double time, long step, std::size_t count, const
   std::snprintf(name_buffer, sizeof name_buffer, "step_%06ld", step);
   const std::string group_name = name_buffer;
 
-  const hdf5::QuietErrors quiet;
+  // The frame's data (ids, coordinates, fields) and the growth of the root group's name heap.
+  std::uintmax_t bytes = count * (8 + 3 * 8) + 64 * m.frames;
+  for (const auto& field : fields) bytes += count * attribute_layout(field.components).second * 8;
+
+  const std::string when = at_step(step, time);
   FrameLayout layout;
-  try {
-    layout = m.write_group(group_name, time, step, count, positions, fields);
-  } catch (...) {
-    // Drop the half-written group (best effort); the XDMF never referenced it.
-    if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0)
-      H5Ldelete(m.file.get(), group_name.c_str(), H5P_DEFAULT);
-    H5Eclear2(H5E_DEFAULT);
-    throw;
-  }
-  m.flush();
+  m.guarded(when, [&] {
+    // A full disk then fails here, before HDF5 has changed the file and its earlier frames.
+    hdf5::reserve(m.file.get(), m.h5_path(), bytes, fields.size() + 3);
+    try {
+      layout = m.write_group(group_name, time, step, count, positions, fields);
+    } catch (...) {
+      // Drop the half-written group (best effort); the XDMF never referenced it.
+      if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0)
+        H5Ldelete(m.file.get(), group_name.c_str(), H5P_DEFAULT);
+      throw;
+    }
+    m.flush();
+    hdf5::reserve(m.file.get(), m.h5_path(), 0, 0);
+  });
   m.add_to_xdmf(layout, step);
-  m.write_xdmf();
+  m.write_xdmf(when);
 }
 
 std::size_t ParticleFieldWriter::frames() const { return impl_->frames; }

@@ -20,6 +20,8 @@
 // atomically (fields.xdmf.partial, then rename), so the XDMF only ever lists complete frames and
 // a run that dies later leaves every earlier frame readable. The HDF5 file is written without
 // file locking, so ParaView or scripts/read_fields.py can open it while the run goes on.
+// Disk space for a frame is reserved before HDF5 writes it, so a full disk stops the run before
+// HDF5 has touched the file: an OutputError (one line: file, step, reason), earlier frames intact.
 //
 // hdf5.h is included by the .cpp only; nothing that includes this header parses it.
 #include <cstddef>
@@ -57,7 +59,8 @@ class ParticleFieldWriter {
   /// between writes. Throws std::runtime_error naming the array ("positions" or the field name)
   /// if a value is not finite, and std::invalid_argument for a bad field name/components, a
   /// repeated field name, a step already written, a negative step or a non-finite time. Nothing
-  /// is written when it throws, and the writer stays usable.
+  /// is written when it throws, and the writer stays usable. A failed write (full disk) is an
+  /// OutputError naming the file and step; the frames before it stay readable.
   void write(double time, long step, std::size_t count, const double* positions,
              const std::vector<FieldView>& fields);
 

@@ -680,7 +680,7 @@ ParticleFieldWriter reopen_fields(const OutputDir& out, long frames) {
 
 /// metrics.csv of the run being restarted, cut back to the rows its checkpoint knows (rewritten
 /// atomically), open for appending.
-std::ofstream reopen_metrics(const OutputDir& out, const std::string& header, long rows) {
+CheckedFile reopen_metrics(const OutputDir& out, const std::string& header, long rows) {
   const std::string path = out.file("metrics.csv");
   std::ifstream in(path);
   std::string line;
@@ -698,7 +698,7 @@ std::ofstream reopen_metrics(const OutputDir& out, const std::string& header, lo
                      std::to_string(rows));
   in.close();
   out.write_text("metrics.csv", kept);
-  return std::ofstream(path, std::ios::app);
+  return CheckedFile(path, /*append=*/true);
 }
 
 }  // namespace
@@ -722,10 +722,9 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   const std::string header = metrics_header();
   ParticleFieldWriter writer =
       options.restart ? reopen_fields(out, loop.frames) : ParticleFieldWriter(out.path(), kDim);
-  std::ofstream metrics = options.restart ? reopen_metrics(out, header, loop.metrics_rows)
-                                          : std::ofstream(out.file("metrics.csv"));
-  if (!options.restart) metrics << header << '\n';
-  metrics << std::setprecision(12);
+  CheckedFile metrics = options.restart ? reopen_metrics(out, header, loop.metrics_rows)
+                                        : CheckedFile(out.file("metrics.csv"), /*append=*/false);
+  if (!options.restart) metrics.write(header + '\n');
   loop.frames = static_cast<long>(writer.frames());
 
   auto write_frame = [&] {
@@ -735,10 +734,11 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
     writer.write(time_, step_, particles_.size(), particles_.field("position").data(), views);
   };
   auto write_metrics = [&] {
-    metrics << time_ << ',' << step_ << ',' << dt_;
-    for (double v : evaluate_probes()) metrics << ',' << v;
-    metrics << '\n';
-    metrics.flush();
+    std::ostringstream row;
+    row << std::setprecision(12) << time_ << ',' << step_ << ',' << dt_;
+    for (double v : evaluate_probes()) row << ',' << v;
+    row << '\n';
+    metrics.write(row.str(), at_step(step_, time_));  // a whole row or an error, never half a row
   };
 
   const double eps = 1e-9 * end_time_;
