@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 namespace frostmpm {
 
 OutputError::OutputError(const std::string& path, const std::string& reason, const std::string& when)
-    : InputError("cannot write " + path + when + ": " + reason) {}
+    : InputError("cannot write " + path + when + ": " + reason), reason_(reason) {}
 
 OutputError::~OutputError() = default;
 
@@ -69,10 +69,10 @@ void write_file_atomically(const std::string& path, std::string_view text, const
     std::error_code ec;
     fs::rename(temp_path, path, ec);
     if (ec) throw OutputError(path, ec.message(), when);
-  } catch (const OutputError&) {
+  } catch (const OutputError& e) {
     std::error_code ignored;
     fs::remove(temp_path, ignored);  // no empty or cut-short .partial left behind
-    throw;
+    throw OutputError(path, e.reason(), when);  // the file the user knows, not the .partial
   }
 }
 

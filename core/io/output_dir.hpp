@@ -19,6 +19,10 @@ class OutputError : public InputError {
   /// "cannot write PATH[ at step S (t = T s)]: REASON".
   OutputError(const std::string& path, const std::string& reason, const std::string& when = "");
   ~OutputError() override;
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string reason_;
 };
 
 /// " at step S (t = T s)", the `when` of an OutputError during a run.

@@ -329,7 +329,7 @@ void ParticleFieldWriter::write(double time, long step, std::size_t count, const
   const std::string when = at_step(step, time);
   FrameLayout layout;
   m.guarded(when, [&] {
-    // A full disk then fails here, before HDF5 has changed the file and its earlier frames.
+    // A full disk fails here, before HDF5 has changed the file and its earlier frames.
     hdf5::reserve(m.file.get(), m.h5_path(), bytes, fields.size() + 3);
     try {
       layout = m.write_group(group_name, time, step, count, positions, fields);

@@ -23,7 +23,8 @@ TEST_CASE("write_file_atomically: a full disk removes the .partial and keeps the
   const std::string path = dir.file("run.json");
   write_file(path, "earlier\n");
   fs::create_symlink("/dev/full", path + ".partial");  // the temp file lands on a full disk
-  REQUIRE_THROWS_AS(write_file_atomically(path, "newer\n"), OutputError);
+  REQUIRE_THROWS_MATCHES(write_file_atomically(path, "newer\n", at_step(3, 2)), OutputError,
+                         Catch::Message("cannot write " + path + " at step 3 (t = 2 s): No space left on device"));
   REQUIRE(read_file(path) == "earlier\n");
   REQUIRE(!fs::exists(fs::symlink_status(path + ".partial")));
   write_file_atomically(path, "newer\n");  // and with room it works
