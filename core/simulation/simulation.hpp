@@ -115,6 +115,8 @@ class Simulation {
   double end_time() const { return end_time_; }
   /// User-fixed time step (0 when automatic).
   double fixed_dt() const { return fixed_dt_; }
+  /// The `time:` section as read, for errors about its keys (e.g. a scheme that needs time.dt).
+  const ParamSet& time_params() const { return time_params_; }
 
   const StepStatistics& statistics() const { return stats_; }
   /// How often this run was restarted from a checkpoint.
@@ -131,6 +133,8 @@ class Simulation {
  private:
   // Recomputes every particle's stencil; a particle whose support leaves the grid stops the run.
   void update_stencil();
+  // Refuses a run whose physics' stable step would need more than time.max_steps steps.
+  void check_step_budget() const;
   struct Probe;
   struct RegionInit;
   /// A scalar field or one component of a vector field ("water_flux.y"): value p is
@@ -156,6 +160,9 @@ class Simulation {
   std::vector<std::unique_ptr<Probe>> probes_;
   std::vector<std::string> output_fields_;
   std::map<std::string, double> state_defaults_;
+  ParamSchema material_schema_;  ///< every physics' material keys; also bounds `initial:` values
+  ParamSet time_params_;
+  long max_steps_ = 0;
   double time_ = 0, dt_ = 0, end_time_ = 0, fixed_dt_ = 0, max_dt_ = 0;
   double output_every_ = 0, metrics_every_ = 0;
   long step_ = 0, restarts_ = 0;

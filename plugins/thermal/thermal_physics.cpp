@@ -90,7 +90,7 @@ void ThermalPhysics::setup(Simulation& sim) {
   material_ = sim.particle_materials();
   read_boundaries(sim);
   if (implicit_ && sim.fixed_dt() <= 0)
-    throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
+    throw sim.time_params().error("dt", "physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
 
   const std::size_t nodes = sim.grid().node_count();
   for (auto* v : {&node_volume_, &node_heat_, &node_force_, &node_pending_, &dirichlet_target_})
@@ -122,9 +122,12 @@ std::vector<Stage> ThermalPhysics::stages() {
 }
 
 void ThermalPhysics::read_boundaries(Simulation& sim) {
+  // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
+  constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
+  const double end = sim.end_time();
   auto label = [](const BoundaryCondition* bc) { return bc->type + " condition on " + bc->target_text; };
   for (auto* bc : sim.boundary_conditions("temperature")) {
-    TimeFunction value = TimeFunction::read(bc->node->child("value"));
+    TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, label(bc)});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, label(bc)});
   }
@@ -133,7 +136,8 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
     if (!on_face(bc)) throw bc->node->error("heat_flux acts on a grid face: use nodes: {face: ...}");
-    flux_.push_back({bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value")), 0.0, label(bc)});
+    flux_.push_back(
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, label(bc)});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
     if (!on_face(bc)) throw bc->node->error("convective acts on a grid face: use nodes: {face: ...}");
@@ -141,7 +145,7 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
     const double coefficient = h.as_real();
     if (!(coefficient > 0)) throw h.error("heat transfer coefficient h must be positive (W/m^2/K)");
     convective_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient")), coefficient, label(bc)});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, label(bc)});
   }
 }
 
