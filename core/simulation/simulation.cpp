@@ -360,7 +360,9 @@ std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::strin
   return out;
 }
 
-void Simulation::declare_state_field(const std::string& name, int components, double default_value) {
+void Simulation::declare_state_field(const std::string& name, int components, double default_value,
+                                     double max_magnitude) {
+  state_bounds_[name] = max_magnitude;
   particles_.declare(name, components, default_value);
   state_defaults_[name] = default_value;
 }
@@ -379,6 +381,9 @@ void Simulation::apply_initial_values() {
       if (const ParamSpec* spec = material_schema_.find(key); spec && !spec->in_range(value))
         throw entry.error(number_text(value) + " is outside the range of material parameter '" + key +
                           "'; valid: " + spec->range_text());
+      if (std::abs(value) > state_bounds_.at(key))
+        throw entry.error(number_text(value) + " is beyond the plausible magnitude " +
+                          number_text(state_bounds_.at(key)) + " of '" + key + "'");
       auto column = particles_.field(key);
       const int c = particles_.components(key);
       for (std::size_t p = init.range.begin; p < init.range.end; ++p)
@@ -543,9 +548,25 @@ void Simulation::check_finite() const {
     const std::size_t p = i / c;
     std::ostringstream msg;
     msg << "numerical blow-up: " << name << " = " << column[i] << " at particle " << p << " (x = " << pos[p * kDim]
-        << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_ << " (dt = " << dt_ << " s)";
+        << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_ << " (dt = " << dt_ << " s)"
+        << suspects(p);
     throw NumericalBlowUp(msg.str());
   }
+}
+
+std::string Simulation::suspects(std::size_t particle) const {
+  // Every region holds particles (read_regions refuses one without), so the k-th particle
+  // range is regions.k of the scene.
+  std::string out;
+  for (std::size_t k = 0; k < region_inits_.size(); ++k)
+    if (particle >= region_inits_[k].range.begin && particle < region_inits_[k].range.end)
+      out = "; the particle is in regions." + std::to_string(k) + " (material '" +
+            materials_[region_inits_[k].range.material].name + "')";
+  std::vector<std::string> bcs;
+  for (std::size_t i = 0; i < bcs_.size(); ++i)
+    bcs.push_back(bcs_[i].label());
+  if (!bcs.empty()) out += "; check its values and those of " + join(bcs);
+  return out;
 }
 
 Simulation::ScalarColumn Simulation::scalar_column(const std::string& name) const {

@@ -66,7 +66,7 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
 void ThermalPhysics::setup(Simulation& sim) {
   sim_ = &sim;
   auto& particles = sim.particles();
-  sim.declare_state_field("temperature", 1, 0.0);
+  sim.declare_state_field("temperature", 1, 0.0, /*max_magnitude degC=*/1e4);
   sim.declare_state_field("porosity", 1, 0.0);
   particles.declare("temperature_pic", 1);
   particles.declare("liquid_saturation", 1, 1.0);
@@ -125,11 +125,10 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
   // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
   constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
   const double end = sim.end_time();
-  auto label = [](const BoundaryCondition* bc) { return bc->type + " condition on " + bc->target_text; };
   for (auto* bc : sim.boundary_conditions("temperature")) {
     TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
-    if (bc->on_particles) particle_T_.push_back({bc->particles, value, label(bc)});
-    else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, label(bc)});
+    if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
+    else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
   }
   auto on_face = [](const BoundaryCondition* bc) {
     return !bc->on_particles && std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
@@ -137,7 +136,7 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
     if (!on_face(bc)) throw bc->node->error("heat_flux acts on a grid face: use nodes: {face: ...}");
     flux_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, label(bc)});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
     if (!on_face(bc)) throw bc->node->error("convective acts on a grid face: use nodes: {face: ...}");
@@ -145,7 +144,7 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
     const double coefficient = h.as_real();
     if (!(coefficient > 0)) throw h.error("heat transfer coefficient h must be positive (W/m^2/K)");
     convective_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, label(bc)});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, bc->label()});
   }
 }
 
