@@ -161,10 +161,10 @@ void ConfigNode::reject_unknown(const std::vector<std::string>& valid_keys) cons
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
     if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end()) continue;
-    ConfigNode offending(kv.first, file_, child_path(key));
+    const ConfigNode offending = with(kv.first, child_path(key));  // keeps --set origins
     std::string message = "unknown key '" + key + "'";
     const std::string hint = closest_match(key, valid_keys);
-    if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+    message += hint.empty() ? std::string(".") : "; did you mean '" + hint + "'?";
     message += " Valid keys here: " + (valid_keys.empty() ? std::string("(none)") : join(valid_keys));
     throw offending.error(message);
   }
