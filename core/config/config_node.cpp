@@ -4,15 +4,49 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace frostmpm {
+
+namespace {
+
+/// Scene files above this size are refused before reading: no scene is near it, and a
+/// device such as /dev/zero would otherwise be read until memory runs out.
+constexpr std::uintmax_t kMaxSceneBytes = 16u << 20;
+
+/// yaml-cpp keeps the first of two equal keys and drops the second silently: refuse both,
+/// naming their lines, anywhere in the tree.
+void reject_duplicate_keys(const YAML::Node& node, const std::string& file, const std::string& path) {
+  auto sub = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
+  if (node.IsMap()) {
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("<non-scalar key>");
+      const auto [first, inserted] = seen.emplace(key, kv.first.Mark());
+      if (!inserted) {
+        const YAML::Mark m = kv.first.Mark();
+        const std::string first_line = first->second.is_null() ? "?" : std::to_string(first->second.line + 1);
+        throw InputError(SourceLocation{file, sub(key), m.is_null() ? 0 : m.line + 1, m.is_null() ? 0 : m.column + 1},
+                         "duplicate key '" + key + "' (first on line " + first_line +
+                             "); a key may appear once per section");
+      }
+      reject_duplicate_keys(kv.second, file, sub(key));
+    }
+  } else if (node.IsSequence()) {
+    std::size_t i = 0;
+    for (const auto& item : node) reject_duplicate_keys(item, file, sub(std::to_string(i++)));
+  }
+}
+
+}  // namespace
 
 ConfigNode::ConfigNode(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)),
       file_(std::move(file)),
       path_(std::move(path)),
-      consumed_(std::make_shared<std::set<std::string>>()) {}
+      consumed_(std::make_shared<std::set<std::string>>()),
+      asked_(std::make_shared<std::set<std::string>>()) {}
 
 ConfigNode ConfigNode::load_file(const std::string& file) { return load_string(read_file(file), file); }
 
@@ -22,6 +56,11 @@ std::string ConfigNode::read_file(const std::string& file) {
     throw InputError(file + ": scene file does not exist");
   if (std::filesystem::is_directory(file, ec))
     throw InputError(file + ": is a directory, expected a YAML scene file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError(file + ": is not a regular file (a device or pipe), expected a YAML scene file");
+  if (std::filesystem::file_size(file, ec) > kMaxSceneBytes)
+    throw InputError(file + ": is larger than " + std::to_string(kMaxSceneBytes >> 20) +
+                     " MB, too large for a YAML scene file");
   std::ifstream in(file);
   if (!in) throw InputError(file + ": cannot be read");
   std::stringstream buffer;
@@ -34,6 +73,7 @@ ConfigNode ConfigNode::load_string(const std::string& text, const std::string& n
     YAML::Node root = YAML::Load(text);
     if (!root.IsMap())
       throw InputError(name + ": a scene must be a YAML mapping of sections (key: value)");
+    reject_duplicate_keys(root, name, "");
     return ConfigNode(root, name, "");
   } catch (const YAML::ParserException& e) {
     SourceLocation where{name, "", e.mark.line + 1, e.mark.column + 1};
@@ -71,6 +111,7 @@ std::string ConfigNode::child_path(const std::string& key) const {
 }
 
 bool ConfigNode::has(const std::string& key) const {
+  asked_->insert(key);
   return node_.IsMap() && node_[key].IsDefined();
 }
 
@@ -102,7 +143,13 @@ void ConfigNode::finish(const std::vector<std::string>& valid_keys) const {
   std::vector<std::string> unread;
   for (const auto& kv : node_)
     if (!consumed_->count(kv.first.as<std::string>())) unread.push_back(kv.first.as<std::string>());
-  if (!unread.empty()) reject_unknown(valid_keys);
+  // Keys read or asked for by whoever owns this section (a physics reading a boundary
+  // condition) are valid here too, besides those the caller lists.
+  std::vector<std::string> valid = valid_keys;
+  for (const auto* set : {consumed_.get(), asked_.get()})
+    for (const auto& key : *set)
+      if (std::find(valid.begin(), valid.end(), key) == valid.end()) valid.push_back(key);
+  if (!unread.empty()) reject_unknown(valid);
   // Keys that are valid but unread are a programming error in the reader, not user input.
   for (const auto& key : unread)
     if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end())
@@ -114,10 +161,10 @@ void ConfigNode::reject_unknown(const std::vector<std::string>& valid_keys) cons
   for (const auto& kv : node_) {
     const std::string key = kv.first.as<std::string>();
     if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end()) continue;
-    ConfigNode offending(kv.first, file_, child_path(key));
+    const ConfigNode offending = with(kv.first, child_path(key));  // keeps --set origins
     std::string message = "unknown key '" + key + "'";
     const std::string hint = closest_match(key, valid_keys);
-    if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+    message += hint.empty() ? std::string(".") : "; did you mean '" + hint + "'?";
     message += " Valid keys here: " + (valid_keys.empty() ? std::string("(none)") : join(valid_keys));
     throw offending.error(message);
   }
@@ -216,8 +263,9 @@ void apply_override(YAML::Node& root, const std::string& assignment) {
   try {
     parsed = YAML::Load(value);
   } catch (const YAML::Exception& e) {
-    throw InputError("--set " + assignment + ": the value is not valid YAML: " + e.msg);
+    throw InputError(SourceLocation{"--set " + assignment, path, 0, 0}, "the value is not valid YAML: " + e.msg);
   }
+  reject_duplicate_keys(parsed, "--set " + assignment, path);
   if (node.IsSequence()) {
     char* end = nullptr;
     const long index = std::strtol(parts.back().c_str(), &end, 10);

@@ -17,7 +17,8 @@ class ConfigNode {
  public:
   ConfigNode(YAML::Node node, std::string file, std::string path = "");
 
-  /// Parses a scene file; a missing file or malformed YAML is an InputError.
+  /// Parses a scene file; a missing file, one that is not a regular file or is over 16 MB,
+  /// malformed YAML and a key given twice in one mapping are InputErrors.
   static ConfigNode load_file(const std::string& file);
   /// The text of a scene file; an InputError when it is missing or cannot be read.
   static std::string read_file(const std::string& file);
@@ -66,6 +67,7 @@ class ConfigNode {
   std::string file_;
   std::string path_;
   std::shared_ptr<std::set<std::string>> consumed_;
+  std::shared_ptr<std::set<std::string>> asked_;  ///< keys has() was asked about: valid here
   std::shared_ptr<const std::vector<std::string>> overrides_;
 
   ConfigNode with(YAML::Node node, std::string path) const;  ///< a child sharing file and overrides

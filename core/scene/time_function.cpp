@@ -89,6 +89,21 @@ TimeFunction TimeFunction::expression(const std::string& text) {
   return f;
 }
 
+TimeFunction TimeFunction::read(const ConfigNode& node, double max_magnitude, double end_time) {
+  const TimeFunction f = read(node);
+  constexpr int kSamples = 16;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double t = end_time * i / kSamples;
+    const double v = f(t);
+    if (!std::isfinite(v) || std::abs(v) > max_magnitude)
+      throw node.error("the value at t = " + number_text(t) + " s is " + number_text(v) +
+                       (std::isfinite(v) ? ", beyond the plausible magnitude " + number_text(max_magnitude)
+                                         : std::string(", not a finite number")));
+    if (f.is_constant()) break;
+  }
+  return f;
+}
+
 TimeFunction TimeFunction::read(const ConfigNode& node) {
   if (node.is_scalar()) {
     const std::string text = node.as_string();

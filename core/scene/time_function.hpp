@@ -39,6 +39,10 @@ class TimeFunction {
   /// Reads any of the three forms; consumes the node's keys and calls finish(). Every problem
   /// is an InputError naming the YAML path and line.
   static TimeFunction read(const ConfigNode& node);
+  /// read(), then evaluated at setup at t = 0, `end_time` and points between: a value that is
+  /// not finite (1/t, log(0)) or whose magnitude exceeds `max_magnitude` (in the quantity's
+  /// unit) is an InputError naming the node, instead of a blow-up during the run.
+  static TimeFunction read(const ConfigNode& node, double max_magnitude, double end_time);
 
   /// Value at time t. With `extrapolation: error`, a t outside the table is an InputError
   /// pointing at the table in the scene.

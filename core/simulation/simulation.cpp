@@ -15,6 +15,7 @@
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
+#include "frostmpm/simulation/run_budget.hpp"
 #include "frostmpm/scene/region.hpp"
 
 namespace frostmpm {
@@ -86,8 +87,10 @@ RunInterrupted::RunInterrupted(int signal_number, double at_time, long at_step)
 void Simulation::read_grid(const ConfigNode& node) {
   ParamSchema s;
   s.reals("origin", "m", "lower-left corner of the grid").size(kDim).defaults_to(std::vector<double>(kDim, 0.0));
-  s.reals("cells", "-", "number of cells along each axis").size(kDim).at_least(1);
-  s.reals("cell_size", "m", "cell size: one value (square cells) or one per axis").above(0);
+  // At most 1e8 per axis: an int, and the 50-million-node cap below still applies.
+  s.reals("cells", "-", "number of cells along each axis").size(kDim).at_least(1).at_most(1e8);
+  // Bounded so that cell volumes and particle volumes stay normal doubles (1e-300 m gave NaN).
+  s.reals("cell_size", "m", "cell size: one value (square cells) or one per axis").at_least(1e-6).at_most(1e6);
   s.choice("shape_function", shape_kind_names(), "MPM shape functions").defaults_to("gimp");
   s.integer("particles_per_cell", "particles per cell along each axis").defaults_to(2L).at_least(1).at_most(8);
   const ParamSet p = parse_params(s, node);
@@ -102,6 +105,14 @@ void Simulation::read_grid(const ConfigNode& node) {
     grid_.spacing[d] = h.size() == 1 ? h[0] : h[d];
   }
   if (grid_.node_count() > 50'000'000) throw p.error("cells", "grid too large (over 50 million nodes)");
+  // The particle lattice is allocated before any region is known: estimate it first.
+  const double lattice = double(grid_.cells[0]) * double(grid_.cells[1]) * std::pow(double(p.integer("particles_per_cell")), kDim);
+  const double bytes = lattice * kBytesPerParticle, installed = double(physical_memory_bytes());
+  if (installed > 0 && bytes > installed)
+    throw p.error("particles_per_cell", "cells × particles_per_cell^" + std::to_string(kDim) + " = " +
+                                            number_text(lattice, 3) + " particles need about " + bytes_text(bytes) +
+                                            " of memory, more than the " + bytes_text(installed) +
+                                            " installed; use fewer cells or particles per cell");
   shape_ = parse_shape_kind(p.string("shape_function"));
   grid_.ghost_layers = ghost_layers(shape_);
   stencil_.configure(shape_);
@@ -113,10 +124,16 @@ void Simulation::read_time(const ConfigNode& node) {
   s.real("end", "s", "simulated end time").above(0);
   s.real("dt", "s", "fixed time step; 0 = automatic from the physics' stability limits").defaults_to(0.0).at_least(0);
   s.real("dt_max", "s", "upper bound on an automatic step; 0 = none").defaults_to(0.0).at_least(0);
+  s.integer("max_steps", "most steps, metrics rows or field frames a run may take; a scene needing more is refused")
+      .defaults_to(kDefaultMaxSteps).at_least(1);
   const ParamSet p = parse_params(s, node);
   end_time_ = p.real("end");
   fixed_dt_ = p.real("dt");
   max_dt_ = p.real("dt_max");
+  max_steps_ = p.integer("max_steps");
+  if (fixed_dt_ > 0)
+    check_count(p, "dt", end_time_ / fixed_dt_, max_steps_, "steps", "time.end / time.dt");
+  time_params_ = p;
   resolved_["time"] = p.to_yaml();
 }
 
@@ -177,6 +194,7 @@ void Simulation::read_materials(const ConfigNode& node) {
     materials_.push_back(std::move(material));
   }
   resolved_["materials"] = resolved;
+  material_schema_ = merged;
 }
 
 void Simulation::read_regions(const ConfigNode& node) {
@@ -184,6 +202,7 @@ void Simulation::read_regions(const ConfigNode& node) {
     RegionShape shape;
     int material = 0;
     std::unique_ptr<ConfigNode> initial;
+    SourceLocation where;
   };
   std::vector<Parsed> regions;
   YAML::Node resolved(YAML::NodeType::Sequence);
@@ -191,6 +210,7 @@ void Simulation::read_regions(const ConfigNode& node) {
   for (const auto& m : materials_) material_names.push_back(m.name);
   for (const auto& item : node.elements()) {
     Parsed r;
+    r.where = item.where();
     r.shape = read_region_shape(item.child("shape"));
     const ConfigNode mat = item.child("material");
     const std::string name = mat.as_string();
@@ -224,8 +244,13 @@ void Simulation::read_regions(const ConfigNode& node) {
   particles_.declare("volume", 1);
   particles_.declare("half_size", kDim);
   const double volume = grid_.cell_volume() / std::pow(ppc, kDim);
+  const auto lo = grid_.origin, hi = grid_.upper();
   for (std::size_t r = 0; r < regions.size(); ++r) {
-    if (points[r].empty()) continue;
+    // A region without particles was a silent no-op: wholly outside the grid, or covered.
+    if (points[r].empty())
+      throw InputError(regions[r].where, "region " + std::to_string(r) + " contains no particles: its shape lies "
+                       "outside the grid [" + number_text(lo[0]) + ", " + number_text(hi[0]) + "] × [" +
+                       number_text(lo[1]) + ", " + number_text(hi[1]) + "] m or under later regions");
     const ParticleRange range = particles_.append(points[r].size(), regions[r].material);
     auto pos = particles_.field("position");
     auto vol = particles_.field("volume");
@@ -335,7 +360,9 @@ std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::strin
   return out;
 }
 
-void Simulation::declare_state_field(const std::string& name, int components, double default_value) {
+void Simulation::declare_state_field(const std::string& name, int components, double default_value,
+                                     double max_magnitude) {
+  state_bounds_[name] = max_magnitude;
   particles_.declare(name, components, default_value);
   state_defaults_[name] = default_value;
 }
@@ -348,7 +375,15 @@ void Simulation::apply_initial_values() {
     const ConfigNode& node = *init.node;
     node.reject_unknown(settable);
     for (const auto& key : node.keys()) {
-      const double value = node.child(key).as_real();
+      const ConfigNode entry = node.child(key);
+      const double value = entry.as_real();
+      // A material parameter set per region obeys the material's range (porosity in (0, 1)).
+      if (const ParamSpec* spec = material_schema_.find(key); spec && !spec->in_range(value))
+        throw entry.error(number_text(value) + " is outside the range of material parameter '" + key +
+                          "'; valid: " + spec->range_text());
+      if (std::abs(value) > state_bounds_.at(key))
+        throw entry.error(number_text(value) + " is beyond the plausible magnitude " +
+                          number_text(state_bounds_.at(key)) + " of '" + key + "'");
       auto column = particles_.field(key);
       const int c = particles_.components(key);
       for (std::size_t p = init.range.begin; p < init.range.end; ++p)
@@ -368,6 +403,11 @@ void Simulation::read_output(const ConfigNode& node) {
   const ParamSet p = parse_params(s, node, {"fields"});
   output_every_ = p.real("every");
   metrics_every_ = p.real("metrics_every");
+  if (output_every_ > 0)
+    check_count(p, "every", end_time_ / output_every_, max_steps_, "field frames", "time.end / output.every");
+  if (metrics_every_ > 0)
+    check_count(p, "metrics_every", end_time_ / metrics_every_, max_steps_, "metrics rows",
+                "time.end / output.metrics_every");
   YAML::Node out = p.to_yaml();
   const auto names = particles_.field_names();
   if (auto fields = node.optional_child("fields")) {
@@ -394,6 +434,17 @@ void Simulation::read_probes(const ConfigNode* node) {
       else
         for (int d = 0; d < std::min(c, 3); ++d) scalars.push_back(n + "." + "xyz"[d]);
     }
+    // Points a probe samples must lie in the grid's domain (outside, the value was a clamp).
+    const auto lo = grid_.origin, hi = grid_.upper();
+    auto read_inside = [&](const ConfigNode& n) {
+      const auto x = read_point(n);
+      for (int d = 0; d < kDim; ++d)
+        if (x[d] < lo[d] || x[d] > hi[d])
+          throw n.error("the point lies outside the grid [" + number_text(lo[0]) + ", " + number_text(hi[0]) +
+                        "] × [" + number_text(lo[1]) + ", " + number_text(hi[1]) + "] m");
+      return x;
+    };
+    std::map<std::string, SourceLocation> first_use;  // probe name -> where it was first given
     auto check_field = [&](const ConfigNode& f) {
       const std::string name = f.as_string();
       if (std::find(scalars.begin(), scalars.end(), name) == scalars.end())
@@ -406,7 +457,11 @@ void Simulation::read_probes(const ConfigNode* node) {
       probe->type = type.as_string();
       if (std::find(types.begin(), types.end(), probe->type) == types.end())
         throw type.error("unknown probe type '" + probe->type + "'; valid: " + join(types));
-      probe->name = item.child("name").as_string();
+      const ConfigNode name = item.child("name");
+      probe->name = name.as_string();
+      if (const auto [it, fresh] = first_use.emplace(probe->name, name.where()); !fresh)
+        throw name.error("probe name '" + probe->name + "' is used twice (first at " + it->second.describe() +
+                         "); metrics.csv needs one column per name");
       if (probe->type == "integral") {
         for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
         if (auto scale = item.optional_child("scale")) {
@@ -419,12 +474,12 @@ void Simulation::read_probes(const ConfigNode* node) {
       } else {
         probe->field = check_field(item.child("field"));
         if (probe->type == "value_at") {
-          probe->point = read_point(item.child("point"));
+          probe->point = read_inside(item.child("point"));
           item.finish({"type", "name", "field", "point"});
         } else if (probe->type == "isotherm") {
           probe->value = item.child("value").as_real();
-          probe->from = read_point(item.child("from"));
-          probe->to = read_point(item.child("to"));
+          probe->from = read_inside(item.child("from"));
+          probe->to = read_inside(item.child("to"));
           item.finish({"type", "name", "field", "value", "from", "to"});
         } else {
           item.finish({"type", "name", "field"});
@@ -493,9 +548,25 @@ void Simulation::check_finite() const {
     const std::size_t p = i / c;
     std::ostringstream msg;
     msg << "numerical blow-up: " << name << " = " << column[i] << " at particle " << p << " (x = " << pos[p * kDim]
-        << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_ << " (dt = " << dt_ << " s)";
+        << ", y = " << pos[p * kDim + 1] << ") at t = " << time_ << " s, step " << step_ << " (dt = " << dt_ << " s)"
+        << suspects(p);
     throw NumericalBlowUp(msg.str());
   }
+}
+
+std::string Simulation::suspects(std::size_t particle) const {
+  // Every region holds particles (read_regions refuses one without), so the k-th particle
+  // range is regions.k of the scene.
+  std::string out;
+  for (std::size_t k = 0; k < region_inits_.size(); ++k)
+    if (particle >= region_inits_[k].range.begin && particle < region_inits_[k].range.end)
+      out = "; the particle is in regions." + std::to_string(k) + " (material '" +
+            materials_[region_inits_[k].range.material].name + "')";
+  std::vector<std::string> bcs;
+  for (std::size_t i = 0; i < bcs_.size(); ++i)
+    bcs.push_back(bcs_[i].label());
+  if (!bcs.empty()) out += "; check its values and those of " + join(bcs);
+  return out;
 }
 
 Simulation::ScalarColumn Simulation::scalar_column(const std::string& name) const {
@@ -627,6 +698,19 @@ double Simulation::plan_step(const LoopState& loop) const {
   return dt;
 }
 
+void Simulation::check_step_budget() const {
+  // The physics' limits are known once they are initialised; a fixed step was checked in
+  // read_time. (A limit may grow during the run; the step at t = 0 is the estimate.)
+  for (std::size_t i = 0; i < physics_.size(); ++i) {
+    double limit = physics_[i]->stable_time_step();
+    if (max_dt_ > 0) limit = std::min(limit, max_dt_);
+    if (fixed_dt_ > 0 && fixed_dt_ < limit) continue;
+    check_count(time_params_, "end", (end_time_ - time_) / limit, max_steps_, "steps",
+                "the stable step of physics '" + physics_keys_[i] + "' (" + number_text(limit, 3) + " s at t = " +
+                    number_text(time_, 6) + " s) with time.end");
+  }
+}
+
 void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene) {
   const auto start = Clock::now();
   loop.time = time_;
@@ -711,6 +795,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   // On a restart too: whatever a physics derives from the initial state is set up as in a new
   // run, and the checkpoint then overwrites every field and persistent array.
   for (auto& physics : physics_) physics->initialize();
+  check_step_budget();
   LoopState loop;
   if (options.restart) {
     loop = restore_checkpoint(out.path());

@@ -4,6 +4,7 @@
 // 2-D today; grid, shape functions and stencils are templated on the dimension.
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -44,6 +45,8 @@ struct BoundaryCondition {
   std::vector<std::size_t> particles;   ///< particle targets
   bool on_particles = false;
   std::unique_ptr<ConfigNode> node;
+  /// "temperature condition 'boundary_conditions.0' on face x_min": for messages, naming the key.
+  std::string label() const { return type + " condition '" + node->path() + "' on " + target_text; }
 };
 
 /// Thrown when the solution stops being finite; the message says where and when.
@@ -106,8 +109,10 @@ class Simulation {
   std::vector<std::uint16_t> particle_materials() const;
   /// Sets a particle field to each particle's material parameter (before regions' `initial:`).
   void fill_from_materials(const std::string& field, const std::string& parameter);
-  /// Declares a particle field that regions may initialise with `initial: {name: value}`.
-  void declare_state_field(const std::string& name, int components, double default_value);
+  /// Declares a particle field that regions may initialise with `initial: {name: value}`;
+  /// an initial value of larger magnitude than `max_magnitude` is refused as a typo.
+  void declare_state_field(const std::string& name, int components, double default_value,
+                           double max_magnitude = std::numeric_limits<double>::infinity());
   /// Fields a physics can offer to output and probes (declared state or derived fields).
   double time() const { return time_; }
   double dt() const { return dt_; }
@@ -115,6 +120,8 @@ class Simulation {
   double end_time() const { return end_time_; }
   /// User-fixed time step (0 when automatic).
   double fixed_dt() const { return fixed_dt_; }
+  /// The `time:` section as read, for errors about its keys (e.g. a scheme that needs time.dt).
+  const ParamSet& time_params() const { return time_params_; }
 
   const StepStatistics& statistics() const { return stats_; }
   /// How often this run was restarted from a checkpoint.
@@ -131,6 +138,10 @@ class Simulation {
  private:
   // Recomputes every particle's stencil; a particle whose support leaves the grid stops the run.
   void update_stencil();
+  // Refuses a run whose physics' stable step would need more than time.max_steps steps.
+  void check_step_budget() const;
+  // The scene keys a blow-up at `particle` may come from: its region, the boundary conditions.
+  std::string suspects(std::size_t particle) const;
   struct Probe;
   struct RegionInit;
   /// A scalar field or one component of a vector field ("water_flux.y"): value p is
@@ -156,6 +167,10 @@ class Simulation {
   std::vector<std::unique_ptr<Probe>> probes_;
   std::vector<std::string> output_fields_;
   std::map<std::string, double> state_defaults_;
+  std::map<std::string, double> state_bounds_;  ///< largest plausible |initial value| per field
+  ParamSchema material_schema_;  ///< every physics' material keys; also bounds `initial:` values
+  ParamSet time_params_;
+  long max_steps_ = 0;
   double time_ = 0, dt_ = 0, end_time_ = 0, fixed_dt_ = 0, max_dt_ = 0;
   double output_every_ = 0, metrics_every_ = 0;
   long step_ = 0, restarts_ = 0;

@@ -67,7 +67,7 @@ void HydraulicPhysics::setup(Simulation& sim) {
   sim_ = &sim;
   auto& particles = sim.particles();
   sim.declare_state_field("porosity", 1, 0.0);
-  sim.declare_state_field("pore_pressure", 1, 0.0);
+  sim.declare_state_field("pore_pressure", 1, 0.0, /*max_magnitude Pa=*/1e10);
   particles.declare("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
   particles.declare("liquid_velocity", kDim, 0.0);
   particles.declare("water_flux", kDim, 0.0);
@@ -118,21 +118,24 @@ void HydraulicPhysics::setup(Simulation& sim) {
 }
 
 void HydraulicPhysics::read_boundaries(Simulation& sim) {
-  auto label = [](const BoundaryCondition* bc) { return bc->type + " condition on " + bc->target_text; };
+  // Boundary values beyond these are typos or overflow, refused at setup (Pa and m/s).
+  constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
+  const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("pore_pressure")) {
     if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
     PressureCondition c;
     c.nodes = bc->nodes;
-    c.value = TimeFunction::read(bc->node->child("value"));
+    c.value = TimeFunction::read(bc->node->child("value"), kMaxPressure, end);
     if (auto h = bc->node->optional_child("hydrostatic")) c.hydrostatic = h->as_bool();
-    c.label = label(bc);
+    c.label = bc->label();
     pressure_bcs_.push_back(std::move(c));
   }
   for (auto* bc : sim.boundary_conditions("water_flux")) {
     const bool face = !bc->on_particles &&
                       std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
     if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");
-    flux_bcs_.push_back({bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value")), label(bc)});
+    flux_bcs_.push_back(
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxWaterFlux, end), bc->label()});
   }
 }
 

@@ -66,7 +66,7 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
 void ThermalPhysics::setup(Simulation& sim) {
   sim_ = &sim;
   auto& particles = sim.particles();
-  sim.declare_state_field("temperature", 1, 0.0);
+  sim.declare_state_field("temperature", 1, 0.0, /*max_magnitude degC=*/1e4);
   sim.declare_state_field("porosity", 1, 0.0);
   particles.declare("temperature_pic", 1);
   particles.declare("liquid_saturation", 1, 1.0);
@@ -90,7 +90,7 @@ void ThermalPhysics::setup(Simulation& sim) {
   material_ = sim.particle_materials();
   read_boundaries(sim);
   if (implicit_ && sim.fixed_dt() <= 0)
-    throw InputError("physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
+    throw sim.time_params().error("dt", "physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
 
   const std::size_t nodes = sim.grid().node_count();
   for (auto* v : {&node_volume_, &node_heat_, &node_force_, &node_pending_, &dirichlet_target_})
@@ -122,18 +122,21 @@ std::vector<Stage> ThermalPhysics::stages() {
 }
 
 void ThermalPhysics::read_boundaries(Simulation& sim) {
-  auto label = [](const BoundaryCondition* bc) { return bc->type + " condition on " + bc->target_text; };
+  // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
+  constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
+  const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
-    TimeFunction value = TimeFunction::read(bc->node->child("value"));
-    if (bc->on_particles) particle_T_.push_back({bc->particles, value, label(bc)});
-    else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, label(bc)});
+    TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
+    if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
+    else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
   }
   auto on_face = [](const BoundaryCondition* bc) {
     return !bc->on_particles && std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
     if (!on_face(bc)) throw bc->node->error("heat_flux acts on a grid face: use nodes: {face: ...}");
-    flux_.push_back({bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value")), 0.0, label(bc)});
+    flux_.push_back(
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
     if (!on_face(bc)) throw bc->node->error("convective acts on a grid face: use nodes: {face: ...}");
@@ -141,7 +144,7 @@ void ThermalPhysics::read_boundaries(Simulation& sim) {
     const double coefficient = h.as_real();
     if (!(coefficient > 0)) throw h.error("heat transfer coefficient h must be positive (W/m^2/K)");
     convective_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient")), coefficient, label(bc)});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, bc->label()});
   }
 }
 
