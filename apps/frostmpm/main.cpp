@@ -1,6 +1,7 @@
 // The `frostmpm` command: run, check, plugins, describe, test-model.
 #include <charconv>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -211,6 +212,9 @@ int cmd_check(const SceneOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) is a full disk to us: the write fails with EFBIG and the
+  // output code reports it in one line, instead of SIGXFSZ killing the run.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App cli{"FrostMPM — thermo-hydro-mechanical material point method for freezing and thawing ground"};
   cli.require_subcommand(1);
   cli.set_version_flag("--version", FROSTMPM_VERSION);
