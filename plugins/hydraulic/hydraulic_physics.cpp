@@ -94,6 +94,9 @@ void HydraulicPhysics::setup(Simulation& sim) {
   sim.fill_from_materials("porosity", "porosity");
   material_ = sim.particle_materials();
   read_boundaries(sim);
+  for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());
+  std::sort(pressure_nodes_.begin(), pressure_nodes_.end());
+  pressure_nodes_.erase(std::unique(pressure_nodes_.begin(), pressure_nodes_.end()), pressure_nodes_.end());
   // A hydrostatic boundary acts on nodes, not on a material: it needs one water density.
   hydrostatic_density_ = materials_.front().water_density;
   for (const auto& bc : pressure_bcs_)
@@ -109,7 +112,7 @@ void HydraulicPhysics::setup(Simulation& sim) {
   const std::size_t n = particles.size(), nodes = sim.grid().node_count();
   for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_})
     v->assign(n, 0.0);
-  for (auto* v : {&node_mass_, &rhs_, &node_storage_, &node_source_}) v->assign(nodes, 0.0);
+  for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
   if (stabilized_) {
     std::size_t cells = 1;
     for (int d = 0; d < kDim; ++d) cells *= static_cast<std::size_t>(sim.grid().cells[d]);

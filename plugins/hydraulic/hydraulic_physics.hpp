@@ -106,10 +106,13 @@ class HydraulicPhysics final : public Physics {
   // liquid mass (a node no wet particle touches has none and no pressure unknown)
   std::vector<double>*p_ = nullptr, *dp_ = nullptr;
   std::vector<double> node_mass_, rhs_;
-  std::vector<double> node_storage_, node_source_;  ///< Σ_p S_ip V_p n_l c_w and Σ_p S_ip V_p source_p
   // Polynomial pressure projection (Eqs. 66–67): per grid cell, ∫ τ/(2G) over its material
   std::vector<double> cell_stabilization_;
+  std::uint64_t stabilization_version_ = ~std::uint64_t{0};  ///< stencil the cell weights belong to (none yet)
   bool stabilized_ = false;
+  // The pressure-boundary nodes (each once) and their rows as assembled, before the elimination
+  std::vector<std::size_t> pressure_nodes_;
+  std::vector<double> boundary_rows_, boundary_rhs_;
   ColouredBlocks<kDim> blocks_;
   std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
   bool grid_valid_ = false;
@@ -141,6 +144,7 @@ class HydraulicPhysics final : public Physics {
   void update_source();
   /// Adds (τ/2G) ∫ (S − ΠS)ᵀ(S − ΠS) dV / Δt of every cell with material to the matrix (Eq. 67).
   void add_stabilization();
+  void update_cell_stabilization();
   /// Water that entered through the boundaries in this step: the residual of the mass balance
   /// on the nodes whose pressure is prescribed, plus the prescribed fluxes.
   void account_boundary_inflow();

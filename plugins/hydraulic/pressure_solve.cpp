@@ -32,8 +32,6 @@ void HydraulicPhysics::assemble() {
   }
   values_.assign(graph_.nonzeros(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
-  std::fill(node_storage_.begin(), node_storage_.end(), 0.0);
-  std::fill(node_source_.begin(), node_source_.end(), 0.0);
   const int K = st.per_particle();
   const auto v_star = sim_->particles().field("liquid_velocity_predicted");
   blocks_.for_each([&](std::size_t q) {
@@ -43,13 +41,12 @@ void HydraulicPhysics::assemble() {
     const int* slot = graph_.scatter.data() + q * K * K;
     const double k = vol[q] * dt_ * eta_[q];
     const double* v = v_star.data() + q * kDim;
-    const double flux = vol[q] * n_l_[q];
+    const double flux = vol[q] * n_l_[q], storage = vol[q] * storage_[q] / dt_, source = vol[q] * source_[q];
     for (int a = 0; a < K; ++a) {
-      node_storage_[n[a]] += w[a] * vol[q] * storage_[q];
-      node_source_[n[a]] += w[a] * vol[q] * source_[q];
+      values_[slot[a * K + a]] += w[a] * storage;  // M lumped on the diagonal
       double divergence = 0;
       for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * v[d];
-      rhs_[n[a]] += flux * divergence;
+      rhs_[n[a]] += flux * divergence - w[a] * source;
       if (k == 0) continue;
       for (int b = 0; b < K; ++b) {
         double dot = 0;
@@ -58,10 +55,6 @@ void HydraulicPhysics::assemble() {
       }
     }
   });
-  for (std::size_t i = 0; i < nodes; ++i) {
-    values_[graph_.diagonal[i]] += node_storage_[i] / dt_;
-    rhs_[i] -= node_source_[i];
-  }
   if (stabilized_) add_stabilization();
   for (auto& bc : flux_bcs_) {
     const double q = bc.value(time_ + dt_);
@@ -76,6 +69,15 @@ void HydraulicPhysics::assemble() {
       rhs_[bc.nodes[j]] += q * bc.areas[j];
       bc.applied += q * bc.areas[j];
     }
+  }
+
+  // The pressure-boundary rows as assembled, for the inflow they measure after the solve.
+  boundary_rows_.clear();
+  boundary_rhs_.clear();
+  for (const std::size_t i : pressure_nodes_) {
+    boundary_rows_.insert(boundary_rows_.end(), values_.begin() + static_cast<std::ptrdiff_t>(graph_.offsets[i]),
+                          values_.begin() + static_cast<std::ptrdiff_t>(graph_.offsets[i + 1]));
+    boundary_rhs_.push_back(rhs_[i]);
   }
 
   // Fixed rows: pressure boundaries (Δp prescribed) and dry or empty nodes (Δp = 0). Their
@@ -131,6 +133,19 @@ std::array<std::size_t, 4> cell_nodes(const UniformGrid<kDim>& grid, std::size_t
 /// H Δp/Δt has the units of the other terms (docs/architecture.md).
 void HydraulicPhysics::add_stabilization() {
   const auto& grid = sim_->grid();
+  if (stabilization_version_ != sim_->stencil().version()) update_cell_stabilization();
+  for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
+    const double w = cell_stabilization_[c] / (144.0 * dt_);
+    if (w == 0) continue;
+    const auto n = cell_nodes(grid, c);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) values_[graph_.position(n[a], static_cast<int>(n[b]))] += w * kProjection[a][b];
+  }
+}
+
+/// Σ V_p τ/(2G_p) of the particles in each cell: changes only when particles move.
+void HydraulicPhysics::update_cell_stabilization() {
+  const auto& grid = sim_->grid();
   const auto x = sim_->particles().field("position");
   const auto vol = sim_->particles().field("volume");
   std::fill(cell_stabilization_.begin(), cell_stabilization_.end(), 0.0);
@@ -146,49 +161,24 @@ void HydraulicPhysics::add_stabilization() {
     }
     cell_stabilization_[c] += weight;
   }
-  for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
-    const double w = cell_stabilization_[c] / (144.0 * dt_);
-    if (w == 0) continue;
-    const auto n = cell_nodes(grid, c);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) values_[graph_.position(n[a], static_cast<int>(n[b]))] += w * kProjection[a][b];
-  }
+  stabilization_version_ = sim_->stencil().version();
 }
 
-/// inflow_i = ((M + H) Δp)_i / Δt + Σ_p S_ip V_p s_p − Σ_p V_p ∇S_ip · q_p on the nodes of
-/// pressure boundaries (the row of the mass balance their prescribed pressure replaced), plus
-/// the prescribed fluxes: an independent check of the water the run took in.
+/// The water that entered in this step: on each pressure-boundary node the residual of its
+/// unconstrained mass-balance row, r_i = (A Δp − b)_i = ((M + H) Δp / Δt + s − Σ_p V_p ∇S_ip · q_p
+/// − q̂)_i (the corrector makes K Δp exactly the change of Σ V n ∇S · v), plus the prescribed
+/// fluxes. Rows saved before the elimination: no particle pass.
 void HydraulicPhysics::account_boundary_inflow() {
-  const auto& st = sim_->stencil();
-  const std::size_t nodes = node_mass_.size();
-  std::vector<char> on_boundary(nodes, 0);
-  for (const auto& bc : pressure_bcs_)
-    for (const auto i : bc.nodes) on_boundary[i] = 1;
-  std::vector<double> balance(nodes, 0.0);
-  const auto vol = sim_->particles().field("volume");
-  const auto q = sim_->particles().field("water_flux");
-  const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t p) {
-    const auto* n = st.nodes(p);
-    const auto* g = st.gradients(p);
-    for (int a = 0; a < K; ++a) {
-      double divergence = 0;
-      for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * q[p * kDim + d];
-      balance[n[a]] -= vol[p] * divergence;
-    }
-  });
   const auto& dp = *dp_;
-  for (std::size_t i = 0; i < nodes; ++i) balance[i] += node_storage_[i] * dp[i] / dt_ + node_source_[i];
-  for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
-    const double w = cell_stabilization_[c] / (144.0 * dt_);
-    if (w == 0) continue;
-    const auto n = cell_nodes(sim_->grid(), c);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) balance[n[a]] += w * kProjection[a][b] * dp[n[b]];
-  }
   double inflow = 0;
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (on_boundary[i]) inflow += balance[i];
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < pressure_nodes_.size(); ++k) {
+    const std::size_t i = pressure_nodes_[k];
+    double residual = -boundary_rhs_[k];
+    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e)
+      residual += boundary_rows_[at++] * dp[static_cast<std::size_t>(graph_.columns[e])];
+    inflow += residual;
+  }
   for (const auto& bc : flux_bcs_) inflow += bc.applied;
   boundary_inflow_ += dt_ * inflow;
 }
