@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "frostmpm/models/pore_space.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
 #include "frostmpm/transfer/nodal_interpolation.hpp"
@@ -45,13 +46,10 @@ HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
 
 ParamSchema HydraulicPhysics::material_schema() const {
   ParamSchema s;
-  // The same specs as the thermal physics' (a key two physics read is validated once).
-  s.real("porosity", "-", "porosity φ (pore space filled by water and ice)").above(0).below(1);
-  s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0);
+  declare_pore_space_keys(s);  // shared with the thermal physics
   s.real("water_compressibility", "1/Pa", "compressibility of pore water c_w = 1/K_l (INTERFROST: 1e-8)")
       .defaults_to(4.6e-10)
       .at_least(0);
-  s.real("ice_density", "kg/m^3", "intrinsic density of ice ρ_c").defaults_to(917.0).above(0);
   s.real("solid_thermal_expansion", "1/K", "volumetric thermal expansion of the soil grains β_s").defaults_to(0.0);
   s.real("water_thermal_expansion", "1/K", "volumetric thermal expansion of water β_l").defaults_to(0.0);
   s.real("ice_thermal_expansion", "1/K", "volumetric thermal expansion of ice β_c").defaults_to(0.0);

@@ -3,18 +3,18 @@
 #include <algorithm>
 #include <vector>
 
+#include "frostmpm/models/pore_space.hpp"
+
 namespace frostmpm::thermal {
 
 ParamSchema material_schema() {
   ParamSchema s;
-  s.real("porosity", "-", "porosity φ (pore space filled by water and ice)").above(0).below(1);
+  declare_pore_space_keys(s);
   s.real("solid_density", "kg/m^3", "intrinsic density of the solid grains ρ_s").above(0);
   s.real("solid_heat_capacity", "J/kg/K", "specific heat capacity of the solid c_s").above(0);
   s.real("solid_conductivity", "W/m/K", "thermal conductivity of the solid κ_s").above(0);
-  s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0);
   s.real("water_heat_capacity", "J/kg/K", "specific heat capacity of water c_l").defaults_to(4182.0).above(0);
   s.real("water_conductivity", "W/m/K", "thermal conductivity of water κ_l").defaults_to(0.6).above(0);
-  s.real("ice_density", "kg/m^3", "intrinsic density of ice ρ_c").defaults_to(917.0).above(0);
   s.real("ice_heat_capacity", "J/kg/K", "specific heat capacity of ice c_c").defaults_to(2060.0).above(0);
   s.real("ice_conductivity", "W/m/K", "thermal conductivity of ice κ_c").defaults_to(2.14).above(0);
   s.real("latent_heat", "J/kg", "latent heat of fusion L_f").defaults_to(3.34e5).at_least(0);
