@@ -268,13 +268,22 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
     throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored_dim) +
                              "-D frames, not " + std::to_string(dim) + "-D");
   // Frames in step order (group names sort by step only up to six digits).
+  // A frame a SIGKILL cut short may have its link but no readable group or step: it is newer
+  // than every complete frame (frames are written in order), so it is dropped with the rest.
   std::vector<std::pair<long, std::string>> stored;
+  std::vector<std::string> torn;
   for (const auto& name : hdf5::child_names(file)) {
     if (name.rfind("step_", 0) != 0) continue;
-    const hdf5::Handle group = hdf5::open_group(file, name);
-    stored.emplace_back(static_cast<long>(hdf5::read_integer_attribute(group.get(), "step")), name);
+    try {
+      const hdf5::Handle group = hdf5::open_group(file, name);
+      stored.emplace_back(static_cast<long>(hdf5::read_integer_attribute(group.get(), "step")), name);
+    } catch (const std::runtime_error&) {
+      torn.push_back(name);
+    }
   }
   std::sort(stored.begin(), stored.end());
+  for (const auto& name : torn)
+    hdf5::check(H5Ldelete(file, name.c_str(), H5P_DEFAULT), "deleting the cut-short frame " + name);
   if (stored.size() < keep_frames)
     throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored.size()) +
                              " frames, fewer than the " + std::to_string(keep_frames) + " to keep");
