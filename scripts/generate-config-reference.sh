@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Writes docs/config-reference.md from what the code declares, so the reference cannot drift:
 #   - every registered model and physics: `frostmpm describe all --markdown` (their ParamSchemas);
-#   - the kernel's scene sections (grid, time, output, checkpoint, ... read by core/simulation/simulation.cpp,
+#   - the kernel's scene sections (grid, time, output, checkpoint, ... read by core/frostmpm/simulation/simulation.cpp,
 #     which `describe` does not list) and the material keys a physics reads: the output of
 #     `frostmpm check` on two minimal scenes, i.e. every default as the code resolves it.
 #
@@ -84,7 +84,7 @@ closest valid one.
 ## Kernel sections and defaults
 
 `grid`, `time`, `output`, `regions`, `boundary_conditions`, `probes` and `checkpoint` are read by the kernel
-(`core/simulation/simulation.cpp`) and are not listed by `frostmpm describe`; the material keys
+(`core/frostmpm/simulation/simulation.cpp`) and are not listed by `frostmpm describe`; the material keys
 are declared by the physics in play (`Physics::material_schema()`), not by the physics' own
 schema below. **`frostmpm check SCENE` prints every resolved value, defaults included.** This
 minimal simulation scene gives only the required keys:

@@ -14,10 +14,6 @@ namespace frostmpm::hydraulic {
 
 ParamSchema HydraulicPhysics::schema() {
   ParamSchema s;
-  s.reals("gravity", "m/s^2", "body force on the pore water, e.g. [0, -9.81]; [0, 0] makes pressure the excess "
-                              "(non-hydrostatic) pressure, as in the INTERFROST cases")
-      .size(kDim)
-      .defaults_to(std::vector<double>(kDim, 0.0));
   s.real("reference_gravity", "m/s^2", "g in the drag n_l² ρ_l g / (K k_r): the gravity the hydraulic conductivity K "
                                        "[m/s] is defined with (not the body force)")
       .defaults_to(9.81)
@@ -40,7 +36,6 @@ ParamSchema HydraulicPhysics::schema() {
 }
 
 HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
-  for (int d = 0; d < kDim; ++d) gravity_[d] = p.reals("gravity")[d];
   reference_gravity_ = p.real("reference_gravity");
 }
 
@@ -61,15 +56,17 @@ ParamSchema HydraulicPhysics::material_schema() const {
   return s;
 }
 
-void HydraulicPhysics::setup(Simulation& sim) {
-  sim_ = &sim;
-  auto& particles = sim.particles();
+void HydraulicPhysics::setup(Kernel<kDim>& sim) {
+  kernel_ = &sim;
+  // The body force on the pore water is the scene's gravity; [0, 0] makes pressure the excess
+  // (non-hydrostatic) pressure, as in the INTERFROST cases.
+  gravity_ = sim.gravity();
   sim.declare_state_field("porosity", 1, 0.0);
   sim.declare_state_field("pore_pressure", 1, 0.0, /*max_magnitude Pa=*/1e10);
-  particles.declare("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
-  particles.declare("liquid_velocity", kDim, 0.0);
-  particles.declare("water_flux", kDim, 0.0);
-  particles.declare("liquid_velocity_predicted", kDim, 0.0);
+  sim.declare_field("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
+  sim.declare_field("liquid_velocity", kDim, 0.0, FieldKind::Vector);
+  sim.declare_field("water_flux", kDim, 0.0, FieldKind::Vector);
+  sim.declare_field("liquid_velocity_predicted", kDim, 0.0, FieldKind::Vector);
 
   bool compressible = false;
   for (const auto& m : sim.materials()) {
@@ -90,7 +87,7 @@ void HydraulicPhysics::setup(Simulation& sim) {
     materials_.push_back(std::move(models));
   }
   sim.fill_from_materials("porosity", "porosity");
-  material_ = sim.particle_materials();
+  material_ = sim.transfer().materials();
   read_boundaries(sim);
   for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());
   std::sort(pressure_nodes_.begin(), pressure_nodes_.end());
@@ -107,7 +104,7 @@ void HydraulicPhysics::setup(Simulation& sim) {
     throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
                      "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
-  const std::size_t n = particles.size(), nodes = sim.grid().node_count();
+  const std::size_t n = sim.particle_count(), nodes = sim.grid().node_count();
   for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_})
     v->assign(n, 0.0);
   for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
@@ -118,7 +115,7 @@ void HydraulicPhysics::setup(Simulation& sim) {
   }
 }
 
-void HydraulicPhysics::read_boundaries(Simulation& sim) {
+void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
   // Boundary values beyond these are typos or overflow, refused at setup (Pa and m/s).
   constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
   const double end = sim.end_time();
@@ -144,12 +141,12 @@ std::vector<double> HydraulicPhysics::boundary_pressures(const PressureCondition
   const double v = c.value(t);  // once per condition: a table or expression is not cheap
   std::vector<double> p(c.nodes.size(), v);
   for (std::size_t j = 0; j < c.nodes.size(); ++j) {
-    const auto x = sim_->grid().node_position(c.nodes[j]);
+    const auto x = kernel_->grid().node_position(c.nodes[j]);
     if (c.hydrostatic) p[j] = hydrostatic_density_ * reference_gravity_ * (v - x[kDim - 1]);  // v: water table
     if (std::isfinite(p[j])) continue;
     std::ostringstream msg;
     msg << "numerical blow-up: pore pressure boundary value " << p[j] << " from the " << c.label << " (x = " << x[0]
-        << ", y = " << x[1] << ") at t = " << t << " s, step " << sim_->step() << "; check the value's table or expression";
+        << ", y = " << x[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
     throw NumericalBlowUp(msg.str());
   }
   return p;
@@ -163,29 +160,29 @@ void HydraulicPhysics::set_boundary_pressures(double t) {
 }
 
 std::vector<Stage> HydraulicPhysics::stages() {
-  const auto x = particle_field("position", kDim), vol = particle_field("volume"), phi = particle_field("porosity"),
-             S = particle_field("liquid_saturation"), p = particle_field("pore_pressure"),
-             v = particle_field("liquid_velocity", kDim), v_star = particle_field("liquid_velocity_predicted", kDim),
-             q = particle_field("water_flux", kDim);
+  const auto x = position_.read(), vol = volume_.read(), phi = porosity_.read(), S = saturation_.read(),
+             p = pressure_.read(), v = velocity_.read(), v_star = predicted_.read();
   // The nodal pressure is the state while particles stand still: carried between steps.
   // Δp is carried too: it is the next solve's first guess, so a restart needs it to continue bit for bit.
-  const auto p_node = carried_node_field("pore_pressure"), dp = carried_node_field("pressure_increment");
+  const auto p_node = node_pressure_.carried_write(), dp = node_increment_.carried_write();
   // The phase change and the thermal expansion need the temperature when a thermal physics has it.
-  const auto T = optional_read(particle_field("temperature"));
+  const auto T = temperature_field_.optional_read();
   return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T}, {p_node},
            [this] { map_to_grid(); }},
-          {"hydraulic.predict", Phase::PredictMomentum, {p_node, v}, {v_star}, [this] { predict(); }},
-          {"hydraulic.pressure", Phase::Pressure, {v_star, p_node}, {dp}, [this] { solve_pressure(); }},
-          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, dp, p_node}, {v, q, p_node}, [this] { correct(); }},
-          {"hydraulic.map_to_particles", Phase::MapToParticles, {p_node}, {p}, [this] { map_to_particles(); }}};
+          {"hydraulic.predict", Phase::PredictMomentum, {node_pressure_.read(), v}, {predicted_.write()},
+           [this] { predict(); }},
+          {"hydraulic.pressure", Phase::Pressure, {v_star, node_pressure_.read()}, {dp}, [this] { solve_pressure(); }},
+          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, node_increment_.read(), node_pressure_.read()},
+           {velocity_.write(), flux_.write(), p_node}, [this] { correct(); }},
+          {"hydraulic.map_to_particles", Phase::MapToParticles, {node_pressure_.read()}, {pressure_.write()},
+           [this] { map_to_particles(); }}};
 }
 
 void HydraulicPhysics::initialize() {
-  auto& nf = sim_->node_fields();
-  p_ = &nf.values("pore_pressure");
-  dp_ = &nf.values("pressure_increment");
-  temperature_ = sim_->particles().has("temperature");
-  time_ = sim_->time();
+  p_ = &node_pressure_.vector();
+  dp_ = &node_increment_.vector();
+  temperature_ = temperature_field_.bound();
+  time_ = kernel_->time();
   update_coefficients();
   project_to_grid();
 }
@@ -199,10 +196,9 @@ void HydraulicPhysics::begin_step(double time, double dt) {
 
 /// n_l = φ S_l, C_d = n_l² ρ_l g / (K k_r), ξ, η and the storage n_l c_w of every particle.
 void HydraulicPhysics::update_coefficients() {
-  auto& particles = sim_->particles();
-  const auto phi = particles.field("porosity");
-  const auto S = particles.field("liquid_saturation");
-  for (const auto& r : particles.ranges()) {
+  const auto phi = porosity_.values();
+  const auto S = saturation_.values();
+  for (const auto& r : kernel_->particle_ranges()) {
     const auto& m = materials_[r.material];
     const std::span<const double> phi_r(phi.data() + r.begin, r.size()), S_r(S.data() + r.begin, r.size());
     m.absolute->evaluate(phi_r, std::span<double>(k_a_.data() + r.begin, r.size()),
@@ -213,7 +209,7 @@ void HydraulicPhysics::update_coefficients() {
     else
       std::fill(k_r_.begin() + r.begin, k_r_.begin() + r.end, 1.0);
   }
-  parallel_for(particles.size(), [&](std::size_t p) {
+  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     const auto& m = materials_[material_[p]];
     const double rho = m.water_density;
     n_l_[p] = phi[p] * std::clamp(S[p], 0.0, 1.0);
@@ -230,16 +226,13 @@ void HydraulicPhysics::update_coefficients() {
 /// P2G of the particles' pressure (volume-weighted): the nodal state at the start, and
 /// whenever particles have moved.
 void HydraulicPhysics::project_to_grid() {
-  const auto& st = sim_->stencil();
-  auto& particles = sim_->particles();
-  if (blocks_.particles() != particles.size() || blocks_.stencil_version() != st.version())
-    blocks_.build(sim_->grid(), st, support_width(st.kind()));
-  const auto vol = particles.field("volume");
-  const auto p = particles.field("pore_pressure");
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
+  const auto p = pressure_.values();
   std::vector<double> weight(p_->size(), 0.0);
   std::fill(p_->begin(), p_->end(), 0.0);
   const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t q) {
+  kernel_->transfer().scatter([&](std::size_t q) {
     const auto* nodes = st.nodes(q);
     const auto* w = st.weights(q);
     for (int k = 0; k < K; ++k) {
@@ -258,17 +251,16 @@ void HydraulicPhysics::project_to_grid() {
 /// so the pressure solve of step k+1 takes the change made in step k. The volume it removes
 /// over a run is exactly ζ φ ΔS_l − β_m ΔT of every particle.
 void HydraulicPhysics::update_source() {
-  auto& particles = sim_->particles();
-  const auto phi = particles.field("porosity");
-  const auto S = particles.field("liquid_saturation");
-  const double* T = temperature_ ? particles.field("temperature").data() : nullptr;
-  const auto vol = particles.field("volume");
+  const auto phi = porosity_.values();
+  const auto S = saturation_.values();
+  const double* T = temperature_ ? temperature_field_.data() : nullptr;
+  const auto vol = volume_.values();
   if (!primed_) {
     std::copy(S.begin(), S.end(), S_prev_.begin());
-    if (T) std::copy(T, T + particles.size(), T_prev_.begin());
+    if (T) std::copy(T, T + kernel_->particle_count(), T_prev_.begin());
     primed_ = true;
   }
-  parallel_for(particles.size(), [&](std::size_t p) {
+  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     const auto& m = materials_[material_[p]];
     const double s = std::clamp(S[p], 0.0, 1.0), n_c = phi[p] * (1.0 - s);
     const double beta = (1.0 - phi[p]) * m.solid_expansion + phi[p] * s * m.water_expansion +
@@ -278,13 +270,13 @@ void HydraulicPhysics::update_source() {
     S_prev_[p] = S[p];
     if (T) T_prev_[p] = T[p];
   });
-  source_volume_ += dt_ * reproducible_sum(particles.size(), [&](std::size_t p) { return vol[p] * source_[p]; });
+  source_volume_ += dt_ * reproducible_sum(kernel_->particle_count(), [&](std::size_t p) { return vol[p] * source_[p]; });
 }
 
 void HydraulicPhysics::map_to_grid() {
   update_coefficients();
   update_source();
-  const auto& st = sim_->stencil();
+  const auto& st = kernel_->transfer().stencil();
   if (!grid_valid_ || st.version() != projected_version_) project_to_grid();
   // The liquid mass marks the nodes the pressure lives on: a node whose pores hold less than
   // kWetFraction liquid (none, or ice all but completely) has no unknown — its row would be
@@ -292,12 +284,12 @@ void HydraulicPhysics::map_to_grid() {
   // physics read the flux at the particles (water_flux), where the pressure equation's
   // quadrature makes it mass-conserving: no nodal velocity is needed.
   constexpr double kWetFraction = 1e-12;
-  const auto vol = sim_->particles().field("volume");
-  const auto phi = sim_->particles().field("porosity");
+  const auto vol = volume_.values();
+  const auto phi = porosity_.values();
   std::fill(node_mass_.begin(), node_mass_.end(), 0.0);
   std::vector<double> pore_mass(node_mass_.size(), 0.0);
   const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t q) {
+  kernel_->transfer().scatter([&](std::size_t q) {
     const auto* nodes = st.nodes(q);
     const auto* w = st.weights(q);
     const double pores = vol[q] * phi[q] * materials_[material_[q]].water_density;
@@ -317,11 +309,10 @@ void HydraulicPhysics::map_to_grid() {
 /// the liquid momentum with implicit drag and the pressure of the step's start (Eq. 43 with the
 /// gradient form of Eq. 14), at the material points (docs/architecture.md: why there).
 void HydraulicPhysics::predict() {
-  const auto& st = sim_->stencil();
-  auto& particles = sim_->particles();
-  const auto v = particles.field("liquid_velocity");
-  auto v_star = particles.field("liquid_velocity_predicted");
-  parallel_for(particles.size(), [&](std::size_t q) {
+  const auto& st = kernel_->transfer().stencil();
+  const auto v = velocity_.mutable_values();
+  auto v_star = predicted_.mutable_values();
+  parallel_for(kernel_->particle_count(), [&](std::size_t q) {
     const auto grad = nodal_gradient_at(st, q, *p_);
     const double inertia = n_l_[q] * materials_[material_[q]].water_density, denominator = inertia + dt_ * drag_[q];
     for (int d = 0; d < kDim; ++d)
@@ -334,12 +325,11 @@ void HydraulicPhysics::predict() {
 /// v = v* − Δt (ξ / ρ_l) ∇Δp(x_p) at every particle (Eq. 47); p_i += Δp_i. The pressure solve
 /// made Σ_p V_p n_l ∇S_ip · v_p balance storage and boundary inflow exactly.
 void HydraulicPhysics::correct() {
-  const auto& st = sim_->stencil();
-  auto& particles = sim_->particles();
-  const auto v_star = particles.field("liquid_velocity_predicted");
-  auto v = particles.field("liquid_velocity");
-  auto flux = particles.field("water_flux");
-  parallel_for(particles.size(), [&](std::size_t q) {
+  const auto& st = kernel_->transfer().stencil();
+  const auto v_star = predicted_.mutable_values();
+  auto v = velocity_.mutable_values();
+  auto flux = flux_.mutable_values();
+  parallel_for(kernel_->particle_count(), [&](std::size_t q) {
     const auto grad = nodal_gradient_at(st, q, *dp_);
     const double a = dt_ * xi_[q] / materials_[material_[q]].water_density;
     for (int d = 0; d < kDim; ++d) {
@@ -353,8 +343,8 @@ void HydraulicPhysics::correct() {
 
 /// Particle pressure from the nodes (the grid holds the state while particles stand still).
 void HydraulicPhysics::map_to_particles() {
-  const auto& st = sim_->stencil();
-  auto p = sim_->particles().field("pore_pressure");
+  const auto& st = kernel_->transfer().stencil();
+  auto p = pressure_.mutable_values();
   parallel_for(p.size(), [&](std::size_t a) { p[a] = nodal_value_at(st, a, *p_); });
 }
 
@@ -381,7 +371,7 @@ void HydraulicPhysics::restored() {
   iterations_max_ = long(s[2]);
   residual_max_ = s[3];
   // The nodal state came back with the kernel's carried node fields; it belongs to this stencil.
-  projected_version_ = sim_->stencil().version();
+  projected_version_ = kernel_->transfer().version();
   grid_valid_ = true;
 }
 

@@ -28,11 +28,13 @@
 #include "frostmpm/models/permeability_model.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
-#include "frostmpm/simulation/simulation.hpp"
-#include "frostmpm/transfer/coloured_blocks.hpp"
+#include "frostmpm/physics/kernel.hpp"
 #include "frostmpm/transfer/stencil_graph.hpp"
 
 namespace frostmpm::hydraulic {
+
+/// The hydraulic physics runs in 2-D (plane).
+inline constexpr int kDim = 2;
 
 class HydraulicPhysics final : public Physics {
  public:
@@ -49,7 +51,7 @@ class HydraulicPhysics final : public Physics {
   }
   std::vector<std::string> boundary_types() const override { return {"pore_pressure", "water_flux"}; }
 
-  void setup(Simulation& sim) override;
+  void setup(Kernel<kDim>& kernel) override;
   std::vector<Stage> stages() override;
   void initialize() override;
   void begin_step(double time, double dt) override;
@@ -85,8 +87,20 @@ class HydraulicPhysics final : public Physics {
 
   // ---- configuration
   ParamSet params_;
-  Simulation* sim_ = nullptr;
+  Kernel<kDim>* kernel_ = nullptr;
   std::array<double, kDim> gravity_{};
+  // The fields the stages declare (bound by the kernel once the step is resolved).
+  FieldHandle position_ = FieldHandle::particle("position", kDim, FieldKind::Vector);
+  FieldHandle volume_ = FieldHandle::particle("volume");
+  FieldHandle porosity_ = FieldHandle::particle("porosity");
+  FieldHandle saturation_ = FieldHandle::particle("liquid_saturation");
+  FieldHandle temperature_field_ = FieldHandle::particle("temperature");
+  FieldHandle pressure_ = FieldHandle::particle("pore_pressure");
+  FieldHandle velocity_ = FieldHandle::particle("liquid_velocity", kDim, FieldKind::Vector);
+  FieldHandle predicted_ = FieldHandle::particle("liquid_velocity_predicted", kDim, FieldKind::Vector);
+  FieldHandle flux_ = FieldHandle::particle("water_flux", kDim, FieldKind::Vector);
+  FieldHandle node_pressure_ = FieldHandle::node("pore_pressure");
+  FieldHandle node_increment_ = FieldHandle::node("pressure_increment");
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
@@ -94,7 +108,7 @@ class HydraulicPhysics final : public Physics {
   std::vector<FluxCondition> flux_bcs_;
 
   // ---- particles: per-step coefficients
-  std::vector<std::uint16_t> material_;
+  std::span<const std::uint16_t> material_;  ///< material index of every particle (the kernel's)
   std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
@@ -113,7 +127,6 @@ class HydraulicPhysics final : public Physics {
   // The pressure-boundary nodes (each once) and their rows as assembled, before the elimination
   std::vector<std::size_t> pressure_nodes_;
   std::vector<double> boundary_rows_, boundary_rhs_;
-  ColouredBlocks<kDim> blocks_;
   std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
   bool grid_valid_ = false;
 
@@ -134,7 +147,7 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> saved_scalars_;
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
-  void read_boundaries(Simulation& sim);
+  void read_boundaries(Kernel<kDim>& kernel);
   /// The condition's pressure on each of its nodes at time t; not finite stops the run.
   std::vector<double> boundary_pressures(const PressureCondition& c, double t) const;
   /// Nodal pressure = the boundary values at t on every pressure boundary.

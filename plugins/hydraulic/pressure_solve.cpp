@@ -17,11 +17,12 @@
 namespace frostmpm::hydraulic {
 
 void HydraulicPhysics::assemble() {
-  const auto& st = sim_->stencil();
-  const auto vol = sim_->particles().field("volume");
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
   const std::size_t nodes = node_mass_.size();
-  if (!system_ || graph_.stencil_version != st.version()) {
+  if (!system_ || graph_.topology_version != kernel_->transfer().topology_version()) {
     graph_.build(st, nodes);
+    graph_.topology_version = kernel_->transfer().topology_version();
     SolverOptions options;
     options.method = params_.string("solver");
     options.preconditioner = params_.string("preconditioner");
@@ -33,8 +34,8 @@ void HydraulicPhysics::assemble() {
   values_.assign(graph_.nonzeros(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
   const int K = st.per_particle();
-  const auto v_star = sim_->particles().field("liquid_velocity_predicted");
-  blocks_.for_each([&](std::size_t q) {
+  const auto v_star = predicted_.values();
+  kernel_->transfer().scatter([&](std::size_t q) {
     const auto* n = st.nodes(q);
     const auto* w = st.weights(q);
     const auto* g = st.gradients(q);
@@ -61,7 +62,7 @@ void HydraulicPhysics::assemble() {
     if (!std::isfinite(q)) {
       std::ostringstream msg;
       msg << "numerical blow-up: water flux boundary value " << q << " from the " << bc.label << " at t = "
-          << time_ + dt_ << " s, step " << sim_->step() << "; check the value's table or expression";
+          << time_ + dt_ << " s, step " << kernel_->step() << "; check the value's table or expression";
       throw NumericalBlowUp(msg.str());
     }
     bc.applied = 0;
@@ -132,8 +133,8 @@ std::array<std::size_t, 4> cell_nodes(const UniformGrid<kDim>& grid, std::size_t
 /// H_stab (p^{k+1} − p^k) read as a rate, like M33 — τ/(2G) is a compressibility, so only
 /// H Δp/Δt has the units of the other terms (docs/architecture.md).
 void HydraulicPhysics::add_stabilization() {
-  const auto& grid = sim_->grid();
-  if (stabilization_version_ != sim_->stencil().version()) update_cell_stabilization();
+  const auto& grid = kernel_->grid();
+  if (stabilization_version_ != kernel_->transfer().version()) update_cell_stabilization();
   for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
     const double w = cell_stabilization_[c] / (144.0 * dt_);
     if (w == 0) continue;
@@ -145,9 +146,9 @@ void HydraulicPhysics::add_stabilization() {
 
 /// Σ V_p τ/(2G_p) of the particles in each cell: changes only when particles move.
 void HydraulicPhysics::update_cell_stabilization() {
-  const auto& grid = sim_->grid();
-  const auto x = sim_->particles().field("position");
-  const auto vol = sim_->particles().field("volume");
+  const auto& grid = kernel_->grid();
+  const auto x = position_.values();
+  const auto vol = volume_.values();
   std::fill(cell_stabilization_.begin(), cell_stabilization_.end(), 0.0);
   for (std::size_t q = 0; q < vol.size(); ++q) {
     const double weight = vol[q] * materials_[material_[q]].stabilization;
@@ -161,7 +162,7 @@ void HydraulicPhysics::update_cell_stabilization() {
     }
     cell_stabilization_[c] += weight;
   }
-  stabilization_version_ = sim_->stencil().version();
+  stabilization_version_ = kernel_->transfer().version();
 }
 
 /// The water that entered in this step: on each pressure-boundary node the residual of its
@@ -209,7 +210,7 @@ void HydraulicPhysics::solve_pressure() {
   residual_max_ = std::max(residual_max_, stats.relative_residual);
   if (!stats.converged || !std::isfinite(stats.relative_residual)) {
     std::ostringstream msg;
-    msg << "pressure solve did not converge at t = " << time_ << " s (step " << sim_->step() << ", dt = " << dt_
+    msg << "pressure solve did not converge at t = " << time_ << " s (step " << kernel_->step() << ", dt = " << dt_
         << " s): relative residual " << stats.relative_residual << " after " << stats.iterations
         << " " << params_.string("solver") << " iterations (physics.hydraulic.linear_tolerance " << params_.real("linear_tolerance")
         << ", max_linear_iterations " << params_.integer("max_linear_iterations")

@@ -15,13 +15,13 @@ namespace frostmpm::thermal {
 /// Returns Σ_i a_i: heat carried in by the flow [W per m], part of the boundary heat in the
 /// energy balance (0 without convection).
 double ThermalPhysics::particle_flows(bool conduction, bool convection) {
-  const auto& st = sim_->stencil();
-  const auto vol = sim_->particles().field("volume");
-  const auto q = convection ? sim_->particles().field("water_flux") : std::span<double>{};
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
+  const auto q = convection ? water_flux_.values() : std::span<const double>{};
   if (conduction) std::fill(node_force_.begin(), node_force_.end(), 0.0);
   if (convection) std::fill(advection_force_.begin(), advection_force_.end(), 0.0);
   const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t p) {
+  kernel_->transfer().scatter([&](std::size_t p) {
     const auto* nodes = st.nodes(p);
     const auto* g = st.gradients(p);
     double grad[kDim] = {};

@@ -19,7 +19,8 @@ namespace frostmpm::thermal {
 
 void ThermalPhysics::build_graph() {
   const std::size_t nodes = node_volume_.size();
-  graph_.build(sim_->stencil(), nodes);
+  graph_.build(kernel_->transfer().stencil(), nodes);
+  graph_.topology_version = kernel_->transfer().topology_version();
   SolverOptions options;
   options.method = "cg";
   options.preconditioner = params_.string("preconditioner");
@@ -40,8 +41,8 @@ void ThermalPhysics::build_graph() {
 /// columns of fixed nodes (Dirichlet, empty) replaced by the identity: the Newton correction is
 /// zero there, so no right-hand side changes.
 void ThermalPhysics::assemble_conductivity() {
-  const auto& st = sim_->stencil();
-  const auto vol = sim_->particles().field("volume");
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
   const int K = st.per_particle();
   const std::size_t n = st.particles();
   if (assembled_conductivity_.size() != n) assembled_conductivity_.assign(n, std::numeric_limits<double>::quiet_NaN());
@@ -57,7 +58,7 @@ void ThermalPhysics::assemble_conductivity() {
     parallel_for(node_volume_.size(), [&](std::size_t i) {
       if (row_dirty_[i]) std::fill(stiffness_.begin() + long(graph_.offsets[i]), stiffness_.begin() + long(graph_.offsets[i + 1]), 0.0);
     });
-    blocks_.for_each([&](std::size_t p) {
+    kernel_->transfer().scatter([&](std::size_t p) {
       const auto* nodes = st.nodes(p);
       bool touches = false;
       for (int k = 0; k < K; ++k) touches |= row_dirty_[nodes[k]] != 0;
@@ -151,10 +152,10 @@ double ThermalPhysics::line_search(double h) {
 void ThermalPhysics::report_not_finite(double t_end, double h) const {
   std::size_t i = 0;
   while (i + 1 < residual_.size() && std::isfinite(residual_[i]) && std::isfinite((*node_T_)[i])) ++i;
-  const auto x = sim_->grid().node_position(i);
+  const auto x = kernel_->grid().node_position(i);
   std::ostringstream msg;
   msg << "numerical blow-up: temperature equation not finite at grid node " << i << " (x = " << x[0] << ", y = " << x[1]
-      << ") at t = " << t_end << " s, step " << sim_->step() << " (dt = " << h
+      << ") at t = " << t_end << " s, step " << kernel_->step() << " (dt = " << h
       << " s); check boundary values and material parameters";
   throw NumericalBlowUp(msg.str());
 }
@@ -222,8 +223,13 @@ bool ThermalPhysics::newton(double t_end, double h) {
 }
 
 void ThermalPhysics::solve_implicit() {
-  const auto& st = sim_->stencil();
-  if (!system_ || st.version() != graph_.stencil_version) build_graph();
+  const auto& st = kernel_->transfer().stencil();
+  if (!system_ || kernel_->transfer().topology_version() != graph_.topology_version) build_graph();
+  // Particles moved: every weight changed, so the next assembly is a full one.
+  if (assembled_version_ != st.version()) {
+    assembled_conductivity_.clear();
+    assembled_version_ = st.version();
+  }
   assemble_conductivity();
   preconditioner_fresh_ = false;  // the tangent's off-diagonal part changed with κ
   // The convective term is lagged (the temperatures and flux of the step's start): a source for
@@ -255,9 +261,9 @@ void ThermalPhysics::solve_implicit() {
         std::size_t worst = 0;
         for (std::size_t i = 0; i < nodes; ++i)
           if (std::abs(residual_[i]) > std::abs(residual_[worst])) worst = i;
-        const auto x = sim_->grid().node_position(worst);
+        const auto x = kernel_->grid().node_position(worst);
         std::ostringstream msg;
-        msg << "numerical blow-up: the implicit thermal step from t = " << t << " s (step " << sim_->step()
+        msg << "numerical blow-up: the implicit thermal step from t = " << t << " s (step " << kernel_->step()
             << ") did not converge even at dt = " << h << " s after " << max_step_halvings_
             << " halvings; largest energy residual at grid node " << worst << " (x = " << x[0] << ", y = " << x[1]
             << "); check the material parameters and boundary values";

@@ -63,14 +63,13 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
   max_step_halvings_ = p.integer("max_step_halvings");
 }
 
-void ThermalPhysics::setup(Simulation& sim) {
-  sim_ = &sim;
-  auto& particles = sim.particles();
+void ThermalPhysics::setup(Kernel<kDim>& sim) {
+  kernel_ = &sim;
   sim.declare_state_field("temperature", 1, 0.0, /*max_magnitude degC=*/1e4);
   sim.declare_state_field("porosity", 1, 0.0);
-  particles.declare("temperature_pic", 1);
-  particles.declare("liquid_saturation", 1, 1.0);
-  particles.declare("heat_deviation", 1, 0.0);
+  sim.declare_field("temperature_pic", 1);
+  sim.declare_field("liquid_saturation", 1, 1.0);
+  sim.declare_field("heat_deviation", 1, 0.0);
 
   const auto average = params_.string("conductivity_average") == "geometric" ? ConductivityAverage::Geometric
                                                                             : ConductivityAverage::Arithmetic;
@@ -87,7 +86,7 @@ void ThermalPhysics::setup(Simulation& sim) {
     tables.push_back(tables_.back().get());
   }
   sim.fill_from_materials("porosity", "porosity");
-  material_ = sim.particle_materials();
+  material_ = sim.transfer().materials();
   read_boundaries(sim);
   if (implicit_ && sim.fixed_dt() <= 0)
     throw sim.time_params().error("dt", "physics.thermal: the implicit scheme needs a fixed step: set time.dt (seconds)");
@@ -98,7 +97,7 @@ void ThermalPhysics::setup(Simulation& sim) {
   node_pore_heat_.assign(tables.size(), std::vector<double>(nodes, 0.0));
   dirichlet_.assign(nodes, 0);
   nodal_.configure(tables, nodes);
-  const std::size_t n = particles.size();
+  const std::size_t n = sim.particle_count();
   conductivity_.assign(n, 0.0);
   energy_.assign(n, 0.0);
   hint_.resize(n);
@@ -109,19 +108,19 @@ std::vector<Stage> ThermalPhysics::stages() {
   // What other physics may use: the nodal temperature (node field 'temperature', after the
   // solve the end-of-step value) and the particle fields. The nodal heat content and the
   // step's work arrays stay private.
-  const auto T = particle_field("temperature"), d = particle_field("heat_deviation"),
-             phi = particle_field("porosity"), vol = particle_field("volume"), x = particle_field("position", kDim);
-  const auto T_node = node_field("temperature");
-  return {{"thermal.map_to_grid", Phase::MapToGrid, {x, vol, phi, T, d}, {T_node}, [this] { map_to_grid(); }},
+  const auto T = temperature_.read(), d = deviation_.read(), phi = porosity_.read(), vol = volume_.read(),
+             x = position_.read();
+  return {{"thermal.map_to_grid", Phase::MapToGrid, {x, vol, phi, T, d}, {node_temperature_.write()},
+           [this] { map_to_grid(); }},
           // The convective term ρ_l c_l q·∇T, when some physics provides the Darcy flux q.
-          {"thermal.solve", Phase::Energy, {T_node, optional_read(particle_field("water_flux", kDim))}, {T_node},
-           [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
-          {"thermal.map_to_particles", Phase::MapToParticles, {T_node, x, vol, phi, T, d},
-           {T, d, particle_field("temperature_pic"), particle_field("liquid_saturation")},
+          {"thermal.solve", Phase::Energy, {node_temperature_.read(), water_flux_.optional_read()},
+           {node_temperature_.write()}, [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
+          {"thermal.map_to_particles", Phase::MapToParticles, {node_temperature_.read(), x, vol, phi, T, d},
+           {temperature_.write(), deviation_.write(), temperature_pic_.write(), saturation_.write()},
            [this] { map_to_particles(); }}};
 }
 
-void ThermalPhysics::read_boundaries(Simulation& sim) {
+void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
   constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
   const double end = sim.end_time();
@@ -154,18 +153,18 @@ double ThermalPhysics::value_at(const TimeFunction& f, const std::string& label,
   if (std::isfinite(v)) return v;
   std::ostringstream msg;
   msg << "numerical blow-up: temperature boundary value " << v << " from the " << label << " (x = " << place[0]
-      << ", y = " << place[1] << ") at t = " << t << " s, step " << sim_->step() << "; check the value's table or expression";
+      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
   throw NumericalBlowUp(msg.str());
 }
 
 double ThermalPhysics::value_at(const NodeCondition& c, double t) const {
-  return value_at(c.value, c.label, c.nodes.empty() ? std::array<double, kDim>{} : sim_->grid().node_position(c.nodes[0]), t);
+  return value_at(c.value, c.label, c.nodes.empty() ? std::array<double, kDim>{} : kernel_->grid().node_position(c.nodes[0]), t);
 }
 
 double ThermalPhysics::value_at(const ParticleCondition& c, double t) const {
   std::array<double, kDim> place{};
   if (!c.particles.empty())
-    for (int d = 0; d < kDim; ++d) place[d] = sim_->particles().field("position")[c.particles[0] * kDim + d];
+    for (int d = 0; d < kDim; ++d) place[d] = position_.values()[c.particles[0] * kDim + d];
   return value_at(c.value, c.label, place, t);
 }
 
@@ -179,29 +178,27 @@ void ThermalPhysics::evaluate_particle_properties(std::size_t p, double phi, dou
 }
 
 double ThermalPhysics::particle_heat_total() const {
-  const auto& particles = sim_->particles();
-  const auto T = particles.field("temperature");
-  const auto phi = particles.field("porosity");
-  const auto vol = particles.field("volume");
-  return reproducible_sum(particles.size(), [&](std::size_t p) {
+  const auto T = temperature_.values();
+  const auto phi = porosity_.values();
+  const auto vol = volume_.values();
+  return reproducible_sum(kernel_->particle_count(), [&](std::size_t p) {
     int h = hint_[p];
     return vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
   });
 }
 
 void ThermalPhysics::initialize() {
-  node_T_ = &sim_->node_fields().values("temperature");
-  advection_ = sim_->particles().has("water_flux");
+  node_T_ = &node_temperature_.vector();
+  advection_ = water_flux_.bound();
   if (advection_) advection_force_.assign(node_T_->size(), 0.0);
-  auto& particles = sim_->particles();
-  auto T = particles.field("temperature");
-  auto T_pic = particles.field("temperature_pic");
-  auto S = particles.field("liquid_saturation");
-  const auto phi = particles.field("porosity");
-  apply_particle_dirichlet(sim_->time(), /*count_heat=*/false);
+  auto T = temperature_.mutable_values();
+  auto T_pic = temperature_pic_.mutable_values();
+  auto S = saturation_.mutable_values();
+  const auto phi = porosity_.values();
+  apply_particle_dirichlet(kernel_->time(), /*count_heat=*/false);
   // Before any step the PIC temperature is the initial temperature.
   std::copy(T.begin(), T.end(), T_pic.begin());
-  parallel_for(particles.size(), [&](std::size_t p) {
+  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     const auto& table = *tables_[material_[p]];
     hint_[p] = table.locate(T[p], hint_[p]);
     S[p] = table.saturation(T[p], hint_[p]);
@@ -226,8 +223,8 @@ double ThermalPhysics::stable_time_step() const {
   // the diffusion explicit or implicit), whatever the cell size.
   double dt = std::numeric_limits<double>::infinity();
   if (advection_) {
-    const auto q = sim_->particles().field("water_flux");
-    const auto phi = sim_->particles().field("porosity");
+    const auto q = water_flux_.values();
+    const auto phi = porosity_.values();
     dt = advection_cfl_ * parallel_min(
                     conductivity_.size(),
                     [&](std::size_t p) {
@@ -240,7 +237,7 @@ double ThermalPhysics::stable_time_step() const {
                     std::numeric_limits<double>::infinity());
   }
   if (implicit_) return dt;
-  const double h = sim_->grid().min_spacing();
+  const double h = kernel_->grid().min_spacing();
   dt = std::min(dt, cfl_ * h * h / (2.0 * kDim * max_diffusivity_));
   // A convective face is a spring h·A on the node: keep Δt below C V_i/(h A_i) ≈ C (Δx/2)/h.
   for (const auto& bc : convective_) dt = std::min(dt, cfl_ * min_capacity_ * 0.5 * h / bc.coefficient);
@@ -253,14 +250,11 @@ double ThermalPhysics::stable_time_step() const {
 /// of the particles' heat contents: the grid state is then re-derived from the particles, and
 /// every particle's deviation from it recomputed.
 void ThermalPhysics::project_to_grid(bool with_heat) {
-  const auto& st = sim_->stencil();
-  auto& particles = sim_->particles();
-  const std::size_t n = particles.size();
-  if (blocks_.particles() != n || blocks_.stencil_version() != st.version())
-    blocks_.build(sim_->grid(), st, support_width(st.kind()));
-  const auto T = particles.field("temperature");
-  const auto phi = particles.field("porosity");
-  const auto vol = particles.field("volume");
+  const auto& st = kernel_->transfer().stencil();
+  const std::size_t n = kernel_->particle_count();
+  const auto T = temperature_.values();
+  const auto phi = porosity_.values();
+  const auto vol = volume_.values();
   if (with_heat)
     parallel_for(n, [&](std::size_t p) {
       energy_[p] = tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], hint_[p]);
@@ -270,7 +264,7 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
   for (auto& b : nodal_.pore) std::fill(b.begin(), b.end(), 0.0);
   if (with_heat) std::fill(node_heat_.begin(), node_heat_.end(), 0.0);
   const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t p) {
+  kernel_->transfer().scatter([&](std::size_t p) {
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
     const double a = vol[p] * sensible(p, phi[p]), b = vol[p] * phi[p], e = vol[p] * energy_[p];
@@ -299,7 +293,7 @@ void ThermalPhysics::project_to_grid(bool with_heat) {
   invert_nodes();
   update_node_pore_heat();
   // d_p = H_p(T_p) − Σ_i S_ip H_p(T_i): what the grid field cannot represent.
-  auto d = particles.field("heat_deviation");
+  auto d = deviation_.mutable_values();
   parallel_for(n, [&](std::size_t p) {
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
@@ -359,7 +353,7 @@ void ThermalPhysics::set_dirichlet_targets(double time) {
 }
 
 void ThermalPhysics::map_to_grid() {
-  const auto& st = sim_->stencil();
+  const auto& st = kernel_->transfer().stencil();
   // Particles moved (or nothing is carried yet, or particle temperature conditions reset some
   // particles): the grid state is re-derived from the particles.
   if (!grid_valid_ || st.version() != grid_stencil_version_ || !particle_T_.empty()) project_to_grid(true);
@@ -381,22 +375,21 @@ void ThermalPhysics::map_to_grid() {
 // ---- particle update ---------------------------------------------------------------------------
 
 void ThermalPhysics::map_to_particles() {
-  const auto& st = sim_->stencil();
-  auto& particles = sim_->particles();
-  const std::size_t n = particles.size();
+  const auto& st = kernel_->transfer().stencil();
+  const std::size_t n = kernel_->particle_count();
   const int K = st.per_particle();
-  auto T = particles.field("temperature");
-  auto T_pic = particles.field("temperature_pic");
-  auto S = particles.field("liquid_saturation");
-  auto d = particles.field("heat_deviation");
-  const auto phi = particles.field("porosity");
-  const auto vol = particles.field("volume");
+  auto T = temperature_.mutable_values();
+  auto T_pic = temperature_pic_.mutable_values();
+  auto S = saturation_.mutable_values();
+  auto d = deviation_.mutable_values();
+  const auto phi = porosity_.values();
+  const auto vol = volume_.values();
   update_node_pore_heat();
   // How much of its deviation a particle keeps: the FLIP fraction, times the sub-grid
   // relaxation over this step.
   double keep = flip_fraction_;
   if (subgrid_relaxation_ > 0) {
-    const double h = sim_->grid().min_spacing();
+    const double h = kernel_->grid().min_spacing();
     keep *= std::exp(-dt_ * max_diffusivity_ / (subgrid_relaxation_ * h * h));
   }
   long clipped = 0, shedding = 0;
@@ -456,7 +449,7 @@ void ThermalPhysics::map_to_particles() {
 /// The explicit step's bounds: the largest diffusivity κ/C (sensible capacity, the smaller of
 /// thawed and frozen) and the smallest capacity.
 void ThermalPhysics::update_step_limits() {
-  const auto phi = sim_->particles().field("porosity");
+  const auto phi = porosity_.values();
   const std::size_t n = phi.size();
   max_diffusivity_ = parallel_max(
       n, [&](std::size_t p) { return conductivity_[p] / sensible_capacity(p, phi[p]); }, 0.0);
@@ -469,9 +462,9 @@ void ThermalPhysics::update_step_limits() {
 /// (so this step's particle values stay consistent with the nodal temperatures they came
 /// from): E = Σ V_i e_i + Σ_i pending_i + Σ V_p d_p is conserved exactly.
 void ThermalPhysics::shed_to_grid() {
-  const auto& st = sim_->stencil();
+  const auto& st = kernel_->transfer().stencil();
   const int K = st.per_particle();
-  blocks_.for_each([&](std::size_t p) {
+  kernel_->transfer().scatter([&](std::size_t p) {
     if (energy_[p] == 0) return;
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
@@ -482,12 +475,11 @@ void ThermalPhysics::shed_to_grid() {
 /// Particle temperature conditions: the particles are reset to the value (the grid is
 /// re-derived from the particles at the next step); the heat that takes counts as boundary heat.
 void ThermalPhysics::apply_particle_dirichlet(double time, bool count_heat) {
-  auto& particles = sim_->particles();
-  auto T = particles.field("temperature");
-  auto T_pic = particles.field("temperature_pic");
-  auto S = particles.field("liquid_saturation");
-  const auto phi = particles.field("porosity");
-  const auto vol = particles.field("volume");
+  auto T = temperature_.mutable_values();
+  auto T_pic = temperature_pic_.mutable_values();
+  auto S = saturation_.mutable_values();
+  const auto phi = porosity_.values();
+  const auto vol = volume_.values();
   for (const auto& bc : particle_T_) {
     const double value = value_at(bc, time);
     for (std::size_t p : bc.particles) {
@@ -537,11 +529,10 @@ void ThermalPhysics::restored() {
   initialized_ = s[14] != 0;
   // Derived state: κ_p from the particle fields, the grid's coefficients and temperatures from
   // the carried nodal heat.
-  auto& particles = sim_->particles();
-  const auto T = particles.field("temperature");
-  const auto T_pic = particles.field("temperature_pic");
-  const auto phi = particles.field("porosity");
-  parallel_for(particles.size(), [&](std::size_t p) {
+  const auto T = temperature_.values();
+  const auto T_pic = temperature_pic_.values();
+  const auto phi = porosity_.values();
+  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     hint_[p] = tables_[material_[p]]->locate(T[p], hint_[p]);
     evaluate_particle_properties(p, phi[p], pic_properties_ ? T_pic[p] : T[p]);
   });

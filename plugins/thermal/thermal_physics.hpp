@@ -27,13 +27,15 @@
 #include "frostmpm/linalg/sparse_system.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
-#include "frostmpm/simulation/simulation.hpp"
-#include "frostmpm/transfer/coloured_blocks.hpp"
+#include "frostmpm/physics/kernel.hpp"
 #include "frostmpm/transfer/stencil_graph.hpp"
 #include "mixture_properties.hpp"
 #include "nodal_heat.hpp"
 
 namespace frostmpm::thermal {
+
+/// The thermal physics runs in 2-D (plane); its kernels are written for the plane.
+inline constexpr int kDim = 2;
 
 class ThermalPhysics final : public Physics {
  public:
@@ -47,7 +49,7 @@ class ThermalPhysics final : public Physics {
   std::vector<ModelSlot> material_models() const override { return {{"sfcc", SfccModel::kKind, true}}; }
   std::vector<std::string> boundary_types() const override { return {"temperature", "heat_flux", "convective"}; }
 
-  void setup(Simulation& sim) override;
+  void setup(Kernel<kDim>& kernel) override;
   std::vector<Stage> stages() override;
   void initialize() override;
   double stable_time_step() const override;
@@ -77,7 +79,17 @@ class ThermalPhysics final : public Physics {
 
   // ---- configuration -------------------------------------------------------------------------
   ParamSet params_;
-  Simulation* sim_ = nullptr;
+  Kernel<kDim>* kernel_ = nullptr;
+  // The fields the stages declare (bound by the kernel once the step is resolved).
+  FieldHandle position_ = FieldHandle::particle("position", kDim, FieldKind::Vector);
+  FieldHandle volume_ = FieldHandle::particle("volume");
+  FieldHandle porosity_ = FieldHandle::particle("porosity");
+  FieldHandle temperature_ = FieldHandle::particle("temperature");
+  FieldHandle deviation_ = FieldHandle::particle("heat_deviation");
+  FieldHandle temperature_pic_ = FieldHandle::particle("temperature_pic");
+  FieldHandle saturation_ = FieldHandle::particle("liquid_saturation");
+  FieldHandle water_flux_ = FieldHandle::particle("water_flux", kDim, FieldKind::Vector);
+  FieldHandle node_temperature_ = FieldHandle::node("temperature");
   bool implicit_ = false, pic_properties_ = true;
   double flip_fraction_ = 1, subgrid_relaxation_ = 0, cfl_ = 0.5, advection_cfl_ = 0.9;
   double nonlinear_tolerance_ = 1e-6;
@@ -89,13 +101,12 @@ class ThermalPhysics final : public Physics {
 
   // ---- particles (besides the fields temperature, temperature_pic, liquid_saturation,
   // porosity and heat_deviation) ----------------------------------------------------------------
-  std::vector<std::uint16_t> material_;  ///< material index of every particle
+  std::span<const std::uint16_t> material_;  ///< material index of every particle (the kernel's)
   std::vector<double> conductivity_;     ///< κ_p at the property temperature
   std::vector<double> energy_;           ///< scratch: heat content, or deviation shed to the grid
   std::vector<int> hint_;                ///< enthalpy-table interval of every particle
 
   // ---- grid ------------------------------------------------------------------------------------
-  ColouredBlocks<kDim> blocks_;
   NodalHeat nodal_;
   std::vector<double> node_volume_, node_heat_, node_force_;
   std::vector<double>* node_T_ = nullptr;  ///< the kernel's node field 'temperature' (from initialize() on)
@@ -113,6 +124,7 @@ class ThermalPhysics final : public Physics {
   std::vector<double> boundary_diagonal_, boundary_load_;  ///< h A_i and q A_i + h A_i T_a
   std::vector<double> residual_, rhs_, increment_, K_times_T_, K_times_increment_, start_heat_, start_T_;
   std::vector<double> assembled_conductivity_;  ///< κ_p as in stiffness_
+  std::uint64_t assembled_version_ = 0;        ///< the stencil stiffness_ was assembled on
   std::vector<char> row_dirty_;
   long halvings_ = 0;  ///< the last step's substep level (the next step starts one coarser)
   std::vector<double> node_T_before_;  ///< nodal T at the start of the last accepted substep
@@ -134,7 +146,7 @@ class ThermalPhysics final : public Physics {
   std::vector<double> saved_scalars_;  ///< persistent_state() packs the scalars here
 
   // thermal_physics.cpp
-  void read_boundaries(Simulation& sim);
+  void read_boundaries(Kernel<kDim>& kernel);
   /// (1 − φ) C_s: the solid's share of a particle's heat capacity.
   double sensible(std::size_t p, double phi) const { return (1.0 - phi) * constants_[material_[p]].solid_capacity; }
   void evaluate_particle_properties(std::size_t p, double phi, double T_property);

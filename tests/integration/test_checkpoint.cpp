@@ -356,7 +356,10 @@ namespace {
 class MemoryPhysics final : public Physics {
  public:
   MemoryPhysics(std::string name, const ParamSet& p)
-      : name_(std::move(name)), interrupt_at_(p.integer("interrupt_at_step")), extra_(p.boolean("extra_array")) {}
+      : name_(std::move(name)),
+        interrupt_at_(p.integer("interrupt_at_step")),
+        extra_(p.boolean("extra_array")),
+        value_(FieldHandle::particle(field())) {}
 
   static ParamSchema schema() {
     ParamSchema s;
@@ -368,17 +371,16 @@ class MemoryPhysics final : public Physics {
   ParamSchema material_schema() const override { return {}; }
   std::vector<ModelSlot> material_models() const override { return {}; }
   std::vector<std::string> boundary_types() const override { return {}; }
-  void setup(Simulation& sim) override {
+  void setup(Kernel<2>& sim) override {
     sim_ = &sim;
     sim.declare_state_field(field(), 1, 0.0);
     nodal_.assign(sim.grid().node_count(), 0.0);
   }
   std::vector<Stage> stages() override {
-    return {{name_ + ".update", Phase::UpdateMaterials, {particle_field(field())}, {particle_field(field())},
-             [this] { update(); }}};
+    return {{name_ + ".update", Phase::UpdateMaterials, {value_.read()}, {value_.write()}, [this] { update(); }}};
   }
   void initialize() override {  // an initial condition a restart must overwrite
-    auto v = sim_->particles().field(field());
+    auto v = value_.mutable_values();
     for (std::size_t p = 0; p < v.size(); ++p) v[p] = 1.0 + 1e-3 * double(p);
   }
   double stable_time_step() const override {
@@ -399,12 +401,13 @@ class MemoryPhysics final : public Physics {
   std::string name_;
   long interrupt_at_;
   bool extra_;
-  Simulation* sim_ = nullptr;
+  Kernel<2>* sim_ = nullptr;
+  FieldHandle value_;
   double dt_ = 0;
   std::vector<double> history_, nodal_, empty_, extra_values_;
 
   void update() {
-    auto v = sim_->particles().field(field());
+    auto v = value_.mutable_values();
     const double memory = std::accumulate(history_.begin(), history_.end(), 0.0);
     for (std::size_t p = 0; p < v.size(); ++p) v[p] += dt_ * (1e-3 * memory + nodal_[p % nodal_.size()]);
     for (std::size_t i = 0; i < nodal_.size(); ++i) nodal_[i] = 0.5 * nodal_[i] + 1e-2 * v[i % v.size()];

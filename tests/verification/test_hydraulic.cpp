@@ -75,7 +75,7 @@ TEST_CASE("a hydrostatic column stays at rest: gravity against a hydrostatic bou
   const auto t = run_column(dir, "darcy_column.yaml", 20,
                             {"boundary_conditions=[{type: pore_pressure, nodes: {face: y_max}, value: 1.0, "
                              "hydrostatic: true}]",
-                             "physics.hydraulic.gravity=[0, -9.81]"},
+                             "gravity=[0, -9.81]"},
                             "hydrostatic");
   const auto& last = t.rows.back();
   CHECK(last[t.column("p_mid")] == Approx(4905.0).epsilon(1e-8));

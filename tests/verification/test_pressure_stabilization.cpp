@@ -38,7 +38,8 @@ PressureField run_scene(const std::string& yaml) {
   root.finish({"task", "grid", "time", "physics", "materials", "regions", "boundary_conditions", "output", "probes"});
   OutputDir out(dir.file("out"));
   sim.run(out, RunOptions{});
-  return {sim.node_fields().values("pore_pressure"), sim.grid()};
+  const auto p = sim.node_fields().field("pore_pressure");
+  return {std::vector<double>(p.begin(), p.end()), sim.grid()};
 }
 
 /// A 1 m square at 10 kPa excess pressure, drained on the left half of its top only, one

@@ -10,8 +10,6 @@
 
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
-#include "frostmpm/simulation/simulation.hpp"
-#include "frostmpm/transfer/nodal_interpolation.hpp"
 
 namespace grid_sampler {
 
@@ -29,30 +27,35 @@ class GridSampler final : public Physics {
         .defaults_to("update_materials");
     return s;
   }
-  explicit GridSampler(const ParamSet& p) : field_(p.string("field")), phase_(p.string("phase")) {}
+  explicit GridSampler(const ParamSet& p)
+      : field_(p.string("field")),
+        phase_(p.string("phase")),
+        nodal_(FieldHandle::node(field_)),
+        sampled_(FieldHandle::particle(field_ + "_sampled")) {}
 
   ParamSchema material_schema() const override { return {}; }
   std::vector<ModelSlot> material_models() const override { return {}; }
   std::vector<std::string> boundary_types() const override { return {}; }
-  void setup(Simulation& sim) override { sim_ = &sim; }
+  void setup(Kernel<2>& kernel) override { kernel_ = &kernel; }
 
   std::vector<Stage> stages() override {
     Phase phase = Phase::UpdateMaterials;
     for (Phase p : {Phase::MapToGrid, Phase::Energy, Phase::MapToParticles, Phase::UpdateMaterials})
       if (phase_ == phase_name(p)) phase = p;
-    return {{"grid_sampler.sample", phase, {node_field(field_), particle_field("position", kDim)},
-             {particle_field(field_ + "_sampled")}, [this] { sample(); }}};
+    return {{"grid_sampler.sample", phase, {nodal_.read(), position_.read()}, {sampled_.write()}, [this] { sample(); }}};
   }
 
  private:
   std::string field_, phase_;
-  Simulation* sim_ = nullptr;
+  Kernel<2>* kernel_ = nullptr;
+  FieldHandle nodal_, sampled_;
+  FieldHandle position_ = FieldHandle::particle("position", 2, FieldKind::Vector);
 
   void sample() {
-    const auto& stencil = sim_->stencil();
-    const auto nodal = sim_->node_fields().field(field_);
-    auto out = sim_->particles().field(field_ + "_sampled");
-    for (std::size_t p = 0; p < out.size(); ++p) out[p] = nodal_value_at(stencil, p, nodal);
+    const auto& transfer = kernel_->transfer();
+    const auto nodal = nodal_.values();
+    auto out = sampled_.mutable_values();
+    for (std::size_t p = 0; p < out.size(); ++p) out[p] = transfer.value_at(p, nodal);
   }
 };
 

@@ -6,6 +6,8 @@
 namespace frostmpm {
 SfccModel::~SfccModel() = default;
 Physics::~Physics() = default;
+void Physics::setup(Kernel<2>&) { throw InputError("this physics does not run in 2-D"); }
+void Physics::setup(Kernel<3>&) { throw InputError("this physics does not run in 3-D yet"); }
 RelativePermeabilityModel::~RelativePermeabilityModel() = default;
 AbsolutePermeabilityModel::~AbsolutePermeabilityModel() = default;
 }  // namespace frostmpm

@@ -17,7 +17,8 @@ struct StencilGraph {
   std::vector<int> columns;          ///< sorted column indices of each row
   std::vector<int> scatter;          ///< CSR position of (particle p, stencil slot a, slot b)
   std::vector<std::size_t> diagonal; ///< CSR position of (i, i); every node has one
-  std::uint64_t stencil_version = 0; ///< the stencil it was built for
+  /// The transfer topology it was built for (Transfer::topology_version(); the caller sets it).
+  std::uint64_t topology_version = ~std::uint64_t{0};
 
   /// Builds the graph of `nodes` nodes from the stencil's particles.
   template <int Dim>

@@ -4,6 +4,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace frostmpm {
 
@@ -18,6 +19,26 @@ const char* phase_name(Phase phase) {
     case Phase::UpdateMaterials: return "update_materials";
   }
   return "?";
+}
+
+std::span<double> FieldHandle::storage() const {
+  if (!column_)
+    throw std::logic_error((location_ == FieldLocation::Node ? "node" : "particle") + std::string(" field '") + name_ +
+                           "' used through a handle the kernel never bound: no stage of the physics declares it, "
+                           "or it is an optional read this scene does not provide");
+  return *column_;
+}
+
+std::span<double> FieldHandle::mutable_values() const {
+  if (!writable_ && column_)
+    throw std::logic_error((location_ == FieldLocation::Node ? "node" : "particle") + std::string(" field '") + name_ +
+                           "' written through a handle that no stage declares as a write");
+  return storage();
+}
+
+std::vector<double>& FieldHandle::vector() const {
+  storage();
+  return *column_;
 }
 
 std::string FieldRef::describe() const {

@@ -39,7 +39,6 @@ void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes) {
   });
   diagonal.resize(nodes);
   for (std::size_t i = 0; i < nodes; ++i) diagonal[i] = position(i, static_cast<int>(i));
-  stencil_version = st.version();
 }
 
 template void StencilGraph::build<2>(const StencilCache<2>&, std::size_t);

@@ -2,19 +2,19 @@
 // A physics plugin contributes coupled equations to the step: it declares the particle fields
 // it keeps, the material parameters and model slots it reads, the boundary-condition types it
 // owns, and the stages it hooks into the kernel's phases, each with the fields it reads and
-// writes (core/step/stage.hpp). Physics couple through those named fields only; the kernel
+// writes (core/frostmpm/step/stage.hpp). Physics couple through those named fields only; the kernel
 // orders the step from the declarations and never names a physical model.
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "frostmpm/config/param_schema.hpp"
+#include "frostmpm/physics/kernel.hpp"
 #include "frostmpm/step/stage.hpp"
 
 namespace frostmpm {
-
-class Simulation;
 
 /// A model a physics needs from every material, e.g. {"sfcc", "sfcc", required}.
 struct ModelSlot {
@@ -44,8 +44,12 @@ class Physics {
   virtual std::vector<std::string> boundary_types() const = 0;
 
   /// Called once after particles exist: declare fields, read materials and boundary
-  /// conditions from `sim`, validate everything; stages() is valid afterwards.
-  virtual void setup(Simulation& sim) = 0;
+  /// conditions from the kernel, validate everything; stages() is valid afterwards. The
+  /// kernel stays valid for the physics' lifetime. A physics implements the dimensions it
+  /// supports (DimensionalPhysics does both for a physics templated on the dimension); the
+  /// other one refuses the scene.
+  virtual void setup(Kernel<2>& kernel);
+  virtual void setup(Kernel<3>& kernel);
   /// The stages this physics adds to the step, with their phases and the fields they read and
   /// write. Called once, after every physics' setup(); nodal fields exist from initialize() on.
   virtual std::vector<Stage> stages() = 0;
@@ -69,6 +73,10 @@ class Physics {
   /// a restart takes its size from the checkpoint, so stable_time_step() is next asked after
   /// that step, exactly as in the uninterrupted run.
   virtual void restored() {}
+  /// The force the boundary condition `bc` (of a type this physics owns) exerts on the
+  /// material, [N] per metre of thickness in 2-D, for `reaction` probes; none when the
+  /// physics does not track it.
+  virtual std::optional<std::array<double, 3>> reaction(const BoundaryCondition& /*bc*/) const { return std::nullopt; }
   /// Counters for run.json (e.g. linear iterations); keys are free-form.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
   /// One value per step for run.json's `per_step` (e.g. a solver's iterations and final

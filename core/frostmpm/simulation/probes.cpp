@@ -1,0 +1,292 @@
+#include "frostmpm/simulation/probes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "frostmpm/config/param_schema.hpp"
+
+namespace frostmpm {
+
+namespace {
+
+std::array<double, Probes::kDim> read_point(const ConfigNode& node) {
+  const auto v = node.as_reals();
+  if (v.size() != Probes::kDim)
+    throw node.error("expected a point with " + std::to_string(Probes::kDim) + " coordinates");
+  return {v[0], v[1]};
+}
+
+int read_component(const ConfigNode& node, int dim) {
+  const std::string c = node.as_string();
+  for (int d = 0; d < dim; ++d)
+    if (c == std::string(1, "xyz"[d])) return d;
+  throw node.error("unknown component '" + c + "'; valid: x, y" + std::string(dim == 3 ? ", z" : ""));
+}
+
+}  // namespace
+
+struct Probes::Probe {
+  std::string name, type, field;
+  std::vector<std::string> fields;
+  std::array<double, kDim> point{}, from{}, to{};
+  double value = 0;
+  int component = 0;
+  std::vector<std::size_t> particles;  ///< followed material points (displacement, settlement)
+  std::vector<double> start;           ///< their initial coordinate along `component`
+  std::string boundary;                ///< reaction: the boundary condition's name
+};
+
+Probes::Probes() = default;
+Probes::~Probes() = default;
+Probes::Probes(Probes&&) noexcept = default;
+Probes& Probes::operator=(Probes&&) noexcept = default;
+
+std::vector<std::string> Probes::scalar_names() const {
+  std::vector<std::string> scalars;
+  const auto& particles = *sources_.particles;
+  for (const auto& n : particles.field_names()) {
+    if (particles.internal(n)) continue;
+    const int c = particles.components(n);
+    const auto parts = component_names(particles.kind(n), c);
+    if (parts.empty()) scalars.push_back(n);
+    else
+      for (const auto& part : parts) scalars.push_back(n + "." + part);
+  }
+  return scalars;
+}
+
+Probes::ScalarColumn Probes::scalar_column(const std::string& name) const {
+  const auto& particles = *sources_.particles;
+  const auto dot = name.rfind('.');
+  if (dot != std::string::npos && !particles.has(name)) {
+    const std::string base = name.substr(0, dot), part = name.substr(dot + 1);
+    const int c = particles.components(base);
+    const auto parts = component_names(particles.kind(base), c);
+    const std::size_t k = static_cast<std::size_t>(std::find(parts.begin(), parts.end(), part) - parts.begin());
+    return {particles.field(base), k, static_cast<std::size_t>(c)};
+  }
+  return {particles.field(name), 0, 1};
+}
+
+void Probes::read(const ConfigNode* node, Sources sources) {
+  sources_ = std::move(sources);
+  resolved_ = YAML::Node(YAML::NodeType::Sequence);
+  if (!node) return;
+  static const std::vector<std::string> types = {"min",          "max",        "value_at", "integral", "isotherm",
+                                                 "displacement", "settlement", "reaction"};
+  const auto scalars = scalar_names();
+  const auto& grid = *sources_.grid;
+  const auto positions = sources_.particles->field("position");
+  const std::size_t n = sources_.particles->size();
+  // Points a probe samples must lie in the grid's domain (outside, the value was a clamp).
+  const auto lo = grid.origin, hi = grid.upper();
+  auto read_inside = [&](const ConfigNode& at) {
+    const auto x = read_point(at);
+    for (int d = 0; d < kDim; ++d)
+      if (x[d] < lo[d] || x[d] > hi[d])
+        throw at.error("the point lies outside the grid [" + number_text(lo[0]) + ", " + number_text(hi[0]) + "] × [" +
+                       number_text(lo[1]) + ", " + number_text(hi[1]) + "] m");
+    return x;
+  };
+  std::map<std::string, SourceLocation> first_use;  // probe name -> where it was first given
+  auto check_field = [&](const ConfigNode& f) {
+    const std::string name = f.as_string();
+    if (std::find(scalars.begin(), scalars.end(), name) == scalars.end())
+      throw f.error("unknown scalar field '" + name + "'; available: " + join(scalars));
+    return name;
+  };
+  for (const auto& item : node->elements()) {
+    auto probe = std::make_unique<Probe>();
+    const ConfigNode type = item.child("type");
+    probe->type = type.as_string();
+    if (std::find(types.begin(), types.end(), probe->type) == types.end())
+      throw type.error("unknown probe type '" + probe->type + "'; valid: " + join(types));
+    const ConfigNode name = item.child("name");
+    probe->name = name.as_string();
+    if (const auto [it, fresh] = first_use.emplace(probe->name, name.where()); !fresh)
+      throw name.error("probe name '" + probe->name + "' is used twice (first at " + it->second.describe() +
+                       "); metrics.csv needs one column per name");
+    if (probe->type == "integral") {
+      for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
+      if (auto scale = item.optional_child("scale")) {
+        probe->value = scale->as_real();
+        if (!std::isfinite(probe->value)) throw scale->error("scale must be a finite number");
+      } else {
+        probe->value = 1.0;
+      }
+      item.finish({"type", "name", "fields", "scale"});
+    } else if (probe->type == "displacement") {
+      const ConfigNode at = item.child("point");
+      probe->point = read_inside(at);
+      probe->component = read_component(item.child("component"), kDim);
+      // The material point that starts nearest to `point` (ties: the lowest index).
+      std::size_t best = 0;
+      double best_d2 = std::numeric_limits<double>::infinity();
+      for (std::size_t p = 0; p < n; ++p) {
+        double d2 = 0;
+        for (int d = 0; d < kDim; ++d) d2 += (positions[p * kDim + d] - probe->point[d]) * (positions[p * kDim + d] - probe->point[d]);
+        if (d2 < best_d2) best_d2 = d2, best = p;
+      }
+      probe->particles = {best};
+      probe->start = {positions[best * kDim + probe->component]};
+      item.finish({"type", "name", "point", "component"});
+    } else if (probe->type == "settlement") {
+      double x_lo = -std::numeric_limits<double>::infinity(), x_hi = std::numeric_limits<double>::infinity();
+      if (auto range = item.optional_child("x_range")) {
+        const auto r = range->as_reals();
+        if (r.size() != 2 || !(r[0] < r[1])) throw range->error("expected [x_min, x_max] with x_min < x_max");
+        x_lo = r[0];
+        x_hi = r[1];
+      }
+      // The top particle of every particle column (columns one particle spacing wide).
+      const auto half = sources_.particles->field("half_size");
+      std::map<long, std::size_t> top;
+      for (std::size_t p = 0; p < n; ++p) {
+        const double x = positions[p * kDim];
+        if (x < x_lo || x > x_hi) continue;
+        const long column = std::lround((x - grid.origin[0]) / (2 * half[p * kDim]));
+        const auto [it, fresh] = top.emplace(column, p);
+        if (!fresh && positions[p * kDim + 1] > positions[it->second * kDim + 1]) it->second = p;
+      }
+      if (top.empty()) throw item.error("no particle lies within x_range");
+      probe->component = kDim - 1;
+      for (const auto& [_, p] : top) {
+        probe->particles.push_back(p);
+        probe->start.push_back(positions[p * kDim + kDim - 1]);
+      }
+      item.finish({"type", "name", "x_range"});
+    } else if (probe->type == "reaction") {
+      const ConfigNode boundary = item.child("boundary");
+      probe->boundary = boundary.as_string();
+      const auto& names = sources_.boundary_names;
+      if (std::find(names.begin(), names.end(), probe->boundary) == names.end())
+        throw boundary.error("no boundary condition is named '" + probe->boundary + "'; named: " +
+                             (names.empty() ? std::string("none (give one a name: key)") : join(names)));
+      probe->component = read_component(item.child("component"), kDim);
+      item.finish({"type", "name", "boundary", "component"});
+    } else {
+      probe->field = check_field(item.child("field"));
+      if (probe->type == "value_at") {
+        probe->point = read_inside(item.child("point"));
+        item.finish({"type", "name", "field", "point"});
+      } else if (probe->type == "isotherm") {
+        probe->value = item.child("value").as_real();
+        probe->from = read_inside(item.child("from"));
+        probe->to = read_inside(item.child("to"));
+        item.finish({"type", "name", "field", "value", "from", "to"});
+      } else {
+        item.finish({"type", "name", "field"});
+      }
+    }
+    resolved_.push_back(YAML::Clone(item.raw()));
+    probes_.push_back(std::move(probe));
+  }
+}
+
+std::string Probes::header() const {
+  std::string header = "time_s,step,dt_s";
+  for (const auto& probe : probes_) header += ',' + probe->name;
+  return header;
+}
+
+double Probes::sample_field(const std::string& field, const std::array<double, kDim>& point) const {
+  // Volume-weighted nodal average of the particle field, then bilinear interpolation.
+  const auto& grid = *sources_.grid;
+  const auto& stencil = sources_.transfer->stencil();
+  const auto [values, component, stride] = scalar_column(field);
+  const auto vol = sources_.particles->field("volume");
+  const std::size_t K = static_cast<std::size_t>(stencil.per_particle());
+  std::array<int, kDim> base{};
+  std::array<double, kDim> frac{};
+  for (int d = 0; d < kDim; ++d) {
+    const double xi = std::clamp((point[d] - grid.origin[d]) / grid.spacing[d], 0.0, double(grid.cells[d]));
+    base[d] = std::min(static_cast<int>(std::floor(xi)), grid.cells[d] - 1);
+    frac[d] = xi - base[d];
+  }
+  std::array<std::size_t, 4> corner{};
+  std::array<double, 4> cw{}, num{}, den{};
+  for (int c = 0; c < 4; ++c) {
+    const int a = c & 1, b = c >> 1;
+    corner[c] = grid.node_index({base[0] + a, base[1] + b});
+    cw[c] = (a ? frac[0] : 1 - frac[0]) * (b ? frac[1] : 1 - frac[1]);
+  }
+  // Only particles whose stencil touches the four corners contribute.
+  const std::size_t n = sources_.particles->size();
+  for (std::size_t p = 0; p < n; ++p) {
+    const auto* nodes = stencil.nodes(p);
+    const auto* w = stencil.weights(p);
+    for (std::size_t k = 0; k < K; ++k)
+      for (int c = 0; c < 4; ++c)
+        if (nodes[k] == corner[c]) {
+          num[c] += vol[p] * w[k] * values[p * stride + component];
+          den[c] += vol[p] * w[k];
+        }
+  }
+  double value = 0, weight = 0;
+  for (int c = 0; c < 4; ++c)
+    if (den[c] > 0) {
+      value += cw[c] * num[c] / den[c];
+      weight += cw[c];
+    }
+  return weight > 0 ? value / weight : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<double> Probes::evaluate() const {
+  std::vector<double> out;
+  const auto& particles = *sources_.particles;
+  const auto vol = particles.field("volume");
+  const auto positions = particles.field("position");
+  for (const auto& probe : probes_) {
+    if (probe->type == "min" || probe->type == "max") {
+      const auto [f, component, stride] = scalar_column(probe->field);
+      double extreme = f[component];
+      for (std::size_t i = component; i < f.size(); i += stride)
+        extreme = probe->type == "min" ? std::min(extreme, f[i]) : std::max(extreme, f[i]);
+      out.push_back(extreme);
+    } else if (probe->type == "integral") {
+      double sum = 0;
+      std::vector<ScalarColumn> cols;
+      for (const auto& name : probe->fields) cols.push_back(scalar_column(name));
+      for (std::size_t p = 0; p < particles.size(); ++p) {
+        double v = vol[p];
+        for (const auto& c : cols) v *= c.values[p * c.stride + c.component];
+        sum += v;
+      }
+      out.push_back(probe->value * sum);
+    } else if (probe->type == "value_at") {
+      out.push_back(sample_field(probe->field, probe->point));
+    } else if (probe->type == "displacement") {
+      const std::size_t p = probe->particles.front();
+      out.push_back(positions[p * kDim + probe->component] - probe->start.front());
+    } else if (probe->type == "settlement") {
+      double sum = 0;
+      for (std::size_t k = 0; k < probe->particles.size(); ++k)
+        sum += probe->start[k] - positions[probe->particles[k] * kDim + probe->component];
+      out.push_back(sum / double(probe->particles.size()));
+    } else if (probe->type == "reaction") {
+      out.push_back(sources_.reaction(probe->boundary)[probe->component]);
+    } else {  // isotherm: distance from `from` to the first crossing of `value` along the line
+      const double length = std::hypot(probe->to[0] - probe->from[0], probe->to[1] - probe->from[1]);
+      const int samples = std::max(2, static_cast<int>(std::ceil(4 * length / sources_.grid->min_spacing())));
+      double previous = 0, crossing = std::numeric_limits<double>::quiet_NaN();
+      for (int s = 0; s <= samples; ++s) {
+        const double f = double(s) / samples;
+        const double v = sample_field(probe->field, {probe->from[0] + f * (probe->to[0] - probe->from[0]),
+                                                     probe->from[1] + f * (probe->to[1] - probe->from[1])}) -
+                         probe->value;
+        if (s > 0 && (previous > 0) != (v > 0)) {
+          const double f0 = double(s - 1) / samples;
+          crossing = (f0 + (f - f0) * previous / (previous - v)) * length;
+          break;
+        }
+        previous = v;
+      }
+      out.push_back(crossing);
+    }
+  }
+  return out;
+}
+
+}  // namespace frostmpm

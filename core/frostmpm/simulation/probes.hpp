@@ -1,0 +1,74 @@
+#pragma once
+// Probes: what metrics.csv records over time. Each probe is one column:
+//   min / max        extreme of a particle scalar (or one component: "stress.yy")
+//   value_at         a particle field interpolated to a point through the grid (volume-weighted)
+//   integral         Σ V_p Π fields × scale
+//   isotherm         distance along a segment to the first crossing of a level
+//   displacement     one component of the displacement of the material point that started
+//                    nearest to `point` (it is followed as it moves)
+//   settlement       mean downward displacement of the material's top surface (the top particle
+//                    of every particle column, optionally within x_range), m, positive down
+//   reaction         one component of the force a boundary condition (named with `name:`)
+//                    exerts on the material, N per m of thickness in 2-D
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "frostmpm/config/config_node.hpp"
+#include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/particles/particle_store.hpp"
+#include "frostmpm/transfer/transfer.hpp"
+
+namespace frostmpm {
+
+class Probes {
+ public:
+  static constexpr int kDim = 2;
+  /// What probes read: the particles (with their positions at the start), the transfer service,
+  /// the grid, the names of the boundary conditions a reaction may name, and the reaction of one.
+  struct Sources {
+    const UniformGrid<kDim>* grid = nullptr;
+    const ParticleStore* particles = nullptr;
+    const Transfer<kDim>* transfer = nullptr;
+    std::vector<std::string> boundary_names;
+    std::function<std::array<double, 3>(const std::string&)> reaction;
+  };
+
+  Probes();
+  ~Probes();
+  Probes(Probes&&) noexcept;
+  Probes& operator=(Probes&&) noexcept;
+
+  /// Reads the `probes:` list (none when `node` is null); particle positions are the initial ones.
+  void read(const ConfigNode* node, Sources sources);
+  /// One value per probe, in order.
+  std::vector<double> evaluate() const;
+  /// "time_s,step,dt_s,<probe names>".
+  std::string header() const;
+  YAML::Node resolved() const { return resolved_; }
+
+  /// A particle field (or one component, "stress.yy", "water_flux.x") interpolated to a point
+  /// through the grid: volume-weighted nodal average, then bilinear interpolation.
+  double sample_field(const std::string& field, const std::array<double, kDim>& point) const;
+
+ private:
+  struct Probe;
+  /// A scalar field or one component of a vector/tensor field: value p is values[p * stride + component].
+  struct ScalarColumn {
+    std::span<const double> values;
+    std::size_t component = 0, stride = 1;
+  };
+  ScalarColumn scalar_column(const std::string& name) const;
+  /// Every scalar name a probe may use: scalar fields and the components of the others.
+  std::vector<std::string> scalar_names() const;
+
+  Sources sources_;
+  std::vector<std::unique_ptr<Probe>> probes_;
+  YAML::Node resolved_;
+};
+
+}  // namespace frostmpm

@@ -1,0 +1,513 @@
+#include "frostmpm/simulation/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "frostmpm/io/log.hpp"
+#include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/io/particle_field_writer.hpp"
+#include "frostmpm/parallel/parallel.hpp"
+#include "frostmpm/simulation/interrupt.hpp"
+#include "frostmpm/simulation/run_budget.hpp"
+
+namespace frostmpm {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Checkpoint group of the nodal fields the kernel carries between steps (no physics key
+/// starts with an underscore).
+constexpr const char* kCarriedNodeFields = "_carried_node_fields";
+
+/// The deformation gradient a mechanics physics keeps (3×3, row-major); when the scene has it,
+/// the kernel derives particle volumes and GIMP domains from it.
+constexpr const char* kDeformationGradient = "deformation_gradient";
+constexpr const char* kInitialVolume = "volume_initial";
+constexpr const char* kInitialHalfSize = "half_size_initial";
+
+double determinant3(const double* F) {
+  return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+}
+
+}  // namespace
+
+Simulation::Simulation(const Registry& registry, const ConfigNode& root) : registry_(registry) {
+  resolved_ = YAML::Node(YAML::NodeType::Map);
+  read_grid(root.child("grid"));
+  read_time(root.child("time"));
+  {
+    const auto gravity = root.optional_child("gravity");
+    read_gravity(gravity ? &*gravity : nullptr);
+  }
+  read_physics(root.child("physics"));
+  read_materials(root.child("materials"));
+  read_regions(root.child("regions"));
+  if (auto bcs = root.optional_child("boundary_conditions")) read_boundary_conditions(*bcs);
+  else resolved_["boundary_conditions"] = YAML::Node(YAML::NodeType::Sequence);
+  for (auto& physics : physics_) physics->setup(*this);
+  for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
+  resolve_step();
+  apply_initial_values();
+  read_output(root.child("output"));
+  {
+    Probes::Sources sources;
+    sources.grid = &grid_;
+    sources.particles = &particles_;
+    sources.transfer = &transfer_;
+    for (const auto& bc : bcs_)
+      if (!bc.name.empty()) sources.boundary_names.push_back(bc.name);
+    sources.reaction = [this](const std::string& name) { return reaction(name); };
+    const auto probes = root.optional_child("probes");
+    probes_.read(probes ? &*probes : nullptr, std::move(sources));
+    resolved_["probes"] = probes_.resolved();
+  }
+  const auto checkpoint = root.optional_child("checkpoint");
+  read_checkpoint(checkpoint ? *checkpoint : ConfigNode(YAML::Node(YAML::NodeType::Map), root.file(), "checkpoint"));
+}
+
+Simulation::~Simulation() = default;
+
+RunInterrupted::RunInterrupted(int signal_number, double at_time, long at_step)
+    : std::runtime_error("interrupted by signal " + std::to_string(signal_number)),
+      signal(signal_number),
+      time(at_time),
+      step(at_step) {}
+
+// ---- Kernel<2> ------------------------------------------------------------------------------------
+
+std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::string& type) {
+  std::vector<BoundaryCondition*> out;
+  for (auto& bc : bcs_)
+    if (bc.type == type) out.push_back(&bc);
+  return out;
+}
+
+void Simulation::declare_state_field(const std::string& name, int components, double default_value,
+                                     double max_magnitude, FieldKind kind) {
+  state_bounds_[name] = max_magnitude;
+  particles_.declare(name, components, default_value, kind);
+  state_defaults_[name] = default_value;
+}
+
+void Simulation::declare_field(const std::string& name, int components, double initial, FieldKind kind) {
+  particles_.declare(name, components, initial, kind);
+}
+
+void Simulation::declare_history(const std::string& name, int components, double initial, FieldKind kind) {
+  particles_.declare_history(name, components, initial, kind);
+}
+
+void Simulation::fill_from_materials(const std::string& field, const std::string& parameter) {
+  auto values = particles_.field(field);
+  for (const auto& r : particles_.ranges())
+    std::fill(values.begin() + r.begin, values.begin() + r.end, materials_[r.material].params.real(parameter));
+}
+
+std::string Simulation::describe_particle(std::size_t p) const {
+  const auto pos = particles_.field("position");
+  std::ostringstream out;
+  out << "particle " << p << " at (" << pos[p * kDim] << ", " << pos[p * kDim + 1] << ")";
+  for (std::size_t k = 0; k < region_inits_.size(); ++k)
+    if (p >= region_inits_[k].range.begin && p < region_inits_[k].range.end)
+      out << " in regions." << k << " (material '" << materials_[region_inits_[k].range.material].name << "')";
+  return out.str();
+}
+
+std::array<double, 3> Simulation::reaction(const std::string& name) const {
+  for (const auto& bc : bcs_) {
+    if (bc.name != name) continue;
+    const std::string& owner = bc_owner_.at(bc.type);
+    for (std::size_t i = 0; i < physics_.size(); ++i)
+      if (physics_keys_[i] == owner)
+        if (const auto force = physics_[i]->reaction(bc)) return *force;
+  }
+  return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+          std::numeric_limits<double>::quiet_NaN()};
+}
+
+// ---- the resolved step ----------------------------------------------------------------------------
+
+void Simulation::resolve_step() {
+  std::vector<StepPlan::Declared> declared;
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    for (auto& stage : physics_[i]->stages()) declared.push_back({std::move(stage), physics_keys_[i], physics_where_[i]});
+  plan_ = StepPlan::resolve(std::move(declared), particles_.field_names());
+  for (const auto& f : plan_.new_particle_fields()) particles_.declare(f.name, f.components, 0.0, f.kind);
+  for (const auto& f : plan_.node_fields()) node_fields_.allocate(f.name, f.components, grid_.node_count());
+  // Particles move when a stage writes their positions: the kernel then keeps their geometry.
+  for (const auto& stage : plan_.stages())
+    for (const auto& f : stage.writes)
+      if (f.location == FieldLocation::Particle && f.name == "position") moving_ = true;
+  if (moving_) {
+    particles_.declare(kInitialVolume, 1);
+    particles_.declare(kInitialHalfSize, kDim, 0.0, FieldKind::Vector);
+    const auto V = particles_.field("volume"), half = particles_.field("half_size");
+    auto V0 = particles_.field(kInitialVolume), half0 = particles_.field(kInitialHalfSize);
+    std::copy(V.begin(), V.end(), V0.begin());
+    std::copy(half.begin(), half.end(), half0.begin());
+  }
+  bind_handles();
+}
+
+void Simulation::bind_handles() {
+  for (auto& stage : plan_.stages()) {
+    for (const auto* list : {&stage.reads, &stage.writes})
+      for (const auto& f : *list) {
+        if (!f.handle) continue;
+        std::vector<double>* column = f.location == FieldLocation::Node ? &node_fields_.values(f.name)
+                                                                        : &particles_.column(f.name);
+        f.handle->bind(column, list == &stage.writes);
+      }
+  }
+}
+
+std::vector<PersistentArray> Simulation::carried_node_fields() {
+  std::vector<PersistentArray> arrays;
+  for (const auto& f : plan_.node_fields())
+    if (f.carried) arrays.push_back({f.name, &node_fields_.values(f.name)});
+  return arrays;
+}
+
+void Simulation::apply_initial_values() {
+  std::vector<std::string> settable;
+  for (const auto& [name, _] : state_defaults_) settable.push_back(name);
+  for (auto& init : region_inits_) {
+    if (!init.node) continue;
+    const ConfigNode& node = *init.node;
+    node.reject_unknown(settable);
+    for (const auto& key : node.keys()) {
+      const ConfigNode entry = node.child(key);
+      const double value = entry.as_real();
+      // A material parameter set per region obeys the material's range (porosity in (0, 1)).
+      if (const ParamSpec* spec = material_schema_.find(key); spec && !spec->in_range(value))
+        throw entry.error(number_text(value) + " is outside the range of material parameter '" + key +
+                          "'; valid: " + spec->range_text());
+      if (std::abs(value) > state_bounds_.at(key))
+        throw entry.error(number_text(value) + " is beyond the plausible magnitude " +
+                          number_text(state_bounds_.at(key)) + " of '" + key + "'");
+      auto column = particles_.field(key);
+      const int c = particles_.components(key);
+      for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+        for (int k = 0; k < c; ++k) column[p * c + k] = value;
+    }
+  }
+}
+
+// ---- geometry and the step ------------------------------------------------------------------------
+
+void Simulation::update_stencil() {
+  const long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  if (outside < 0) return;
+  std::ostringstream msg;
+  msg << "numerical blow-up: " << describe_particle(static_cast<std::size_t>(outside))
+      << " has left the grid (its shape-function support reaches past the grid's edge) at t = " << time_
+      << " s, step " << step_ << "; enlarge the grid, or check the loads and boundary conditions that drive it";
+  throw NumericalBlowUp(msg.str());
+}
+
+/// Particle volumes V = V0 det F and GIMP half-widths l_d = l0_d √(F Fᵀ)_dd: the axis-aligned
+/// extent of the deformed particle domain (exact for an initially round domain; a rigid rotation
+/// keeps it, a stretch along an axis scales it). Held below half a cell so the support stays
+/// three nodes wide.
+void Simulation::update_geometry() {
+  if (!particles_.has(kDeformationGradient)) return;
+  const auto F = particles_.field(kDeformationGradient);
+  const auto V0 = particles_.field(kInitialVolume), half0 = particles_.field(kInitialHalfSize);
+  auto V = particles_.field("volume"), half = particles_.field("half_size");
+  long clamped = 0;
+#pragma omp parallel for schedule(static) reduction(+ : clamped) if (V.size() >= kParallelMinimum)
+  for (std::size_t p = 0; p < V.size(); ++p) {
+    const double* f = F.data() + 9 * p;
+    V[p] = V0[p] * determinant3(f);
+    for (int d = 0; d < kDim; ++d) {
+      const double stretch = std::sqrt(f[3 * d] * f[3 * d] + f[3 * d + 1] * f[3 * d + 1] + f[3 * d + 2] * f[3 * d + 2]);
+      const double limit = 0.5 * grid_.spacing[d] * (1 - 1e-9);
+      double l = half0[p * kDim + d] * stretch;
+      if (l > limit) {
+        l = limit;
+        ++clamped;
+      }
+      half[p * kDim + d] = l;
+    }
+  }
+  clamped_domains_ += clamped;
+}
+
+void Simulation::advance(double dt) {
+  dt_ = dt;
+  auto timed = [&](const std::string& name, const std::function<void()>& fn) {
+    const auto start = Clock::now();
+    fn();
+    stats_.stage_seconds[name] += std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  if (positions_changed_) {
+    timed("kernel.stencil", [&] {
+      if (moving_) update_geometry();
+      update_stencil();
+    });
+    positions_changed_ = false;
+  }
+  particles_.begin_step();
+  for (auto& physics : physics_) physics->begin_step(time_, dt);
+  for (auto& stage : plan_.stages()) timed(stage.name, stage.run);
+  time_ += dt;
+  ++step_;
+  positions_changed_ = moving_;
+  stats_.steps++;
+  stats_.dt_sum += dt;
+  stats_.dt_min = stats_.steps == 1 ? dt : std::min(stats_.dt_min, dt);
+  stats_.dt_max = std::max(stats_.dt_max, dt);
+}
+
+void Simulation::check_finite() const {
+  for (const auto& name : particles_.field_names()) {
+    // State fields and fields with history (stress): what the next step starts from.
+    if (!state_defaults_.count(name) && !particles_.has(ParticleStore::history_name(name))) continue;
+    const auto column = particles_.field(name);
+    const int c = particles_.components(name);
+    // The first non-finite entry (a parallel scan; the smallest index, whatever the threads).
+    const double first = parallel_min(
+        column.size(), [&](std::size_t i) { return std::isfinite(column[i]) ? HUGE_VAL : double(i); }, HUGE_VAL);
+    if (first == HUGE_VAL) continue;
+    const auto i = static_cast<std::size_t>(first);
+    const std::size_t p = i / c;
+    std::ostringstream msg;
+    msg << "numerical blow-up: " << name << " = " << column[i] << " at " << describe_particle(p) << " at t = " << time_
+        << " s, step " << step_ << " (dt = " << dt_ << " s)" << suspects(p);
+    throw NumericalBlowUp(msg.str());
+  }
+}
+
+std::string Simulation::suspects(std::size_t /*particle*/) const {
+  std::vector<std::string> bcs;
+  for (std::size_t i = 0; i < bcs_.size(); ++i) bcs.push_back(bcs_[i].label());
+  return bcs.empty() ? std::string() : "; check the region's values and those of " + join(bcs);
+}
+
+double Simulation::plan_step(const LoopState& loop) const {
+  const double eps = 1e-9 * end_time_;
+  double dt = fixed_dt_ > 0 ? fixed_dt_ : std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < physics_.size(); ++i) {
+    const double limit = physics_[i]->stable_time_step();
+    // A fixed step above a physics' stability limit is cut to it; say so once.
+    if (fixed_dt_ > 0 && limit < fixed_dt_ * (1 - 1e-12) && !warned_dt_cut_) {
+      std::ostringstream message;
+      message << "time.dt = " << fixed_dt_ << " s exceeds the stability limit of physics '" << physics_keys_[i]
+              << "' (" << limit << " s at t = " << time_
+              << " s); the run takes the smaller step (an implicit scheme takes any step)";
+      log::warning(message.str());
+      warned_dt_cut_ = true;
+    }
+    dt = std::min(dt, limit);
+  }
+  if (max_dt_ > 0) dt = std::min(dt, max_dt_);
+  if (!std::isfinite(dt)) dt = end_time_ - time_;
+  // Land exactly on output, metrics and end times without leaving a sliver step: when the
+  // target is less than two steps away, split the remaining gap in two.
+  for (double target : {loop.next_output, metrics_every_ > 0 ? std::min(loop.next_metrics, end_time_) : end_time_,
+                        end_time_}) {
+    const double gap = target - time_;
+    if (gap <= eps) continue;
+    if (dt >= gap - eps) dt = gap;
+    else if (2 * dt > gap) dt = 0.5 * gap;
+  }
+  return dt;
+}
+
+void Simulation::check_step_budget() const {
+  // The physics' limits are known once they are initialised; a fixed step was checked in
+  // read_time. (A limit may grow during the run; the step at t = 0 is the estimate.)
+  for (std::size_t i = 0; i < physics_.size(); ++i) {
+    double limit = physics_[i]->stable_time_step();
+    if (max_dt_ > 0) limit = std::min(limit, max_dt_);
+    if (fixed_dt_ > 0 && fixed_dt_ < limit) continue;
+    check_count(time_params_, "end", (end_time_ - time_) / limit, max_steps_, "steps",
+                "the stable step of physics '" + physics_keys_[i] + "' (" + number_text(limit, 3) + " s at t = " +
+                    number_text(time_, 6) + " s) with time.end");
+  }
+}
+
+void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene) {
+  const auto start = Clock::now();
+  loop.time = time_;
+  loop.step = step_;
+  loop.dt = dt_;
+  loop.statistics = stats_;
+  loop.restarts = restarts_;
+  CheckpointWriter checkpoint(dir);
+  checkpoint.write(scene);
+  checkpoint.write(loop);
+  checkpoint.write(particles_);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    checkpoint.write_physics(physics_keys_[i], physics_[i]->persistent_state());
+  if (const auto carried = carried_node_fields(); !carried.empty())
+    checkpoint.write_physics(kCarriedNodeFields, carried);
+  checkpoint.commit();
+  stats_.stage_seconds["kernel.checkpoint"] += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+LoopState Simulation::restore_checkpoint(const std::string& dir) {
+  const CheckpointReader checkpoint(dir);
+  checkpoint.read(particles_);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    checkpoint.read_physics(physics_keys_[i], physics_[i]->persistent_state());
+  if (const auto carried = carried_node_fields(); !carried.empty())
+    checkpoint.read_physics(kCarriedNodeFields, carried);
+  LoopState loop = checkpoint.loop();
+  time_ = loop.time;
+  step_ = loop.step;
+  dt_ = loop.dt;
+  stats_ = loop.statistics;
+  restarts_ = loop.restarts + 1;
+  for (auto& physics : physics_) physics->restored();
+  return loop;
+}
+
+namespace {
+
+/// fields.h5 of the run being restarted, cut back to the frames its checkpoint knows.
+ParticleFieldWriter reopen_fields(const OutputDir& out, long frames) {
+  if (!std::filesystem::exists(out.file("fields.h5"))) {
+    log::warning(out.file("fields.h5") + " is missing; a new one holds the frames after the checkpoint");
+    return ParticleFieldWriter(out.path(), kDim);
+  }
+  try {
+    return ParticleFieldWriter::reopen(out.path(), kDim, static_cast<std::size_t>(frames));
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string(e.what()) + "; move fields.h5 away to continue without the earlier frames");
+  }
+}
+
+/// metrics.csv of the run being restarted, cut back to the rows its checkpoint knows (rewritten
+/// atomically), open for appending.
+CheckedFile reopen_metrics(const OutputDir& out, const std::string& header, long rows) {
+  const std::string path = out.file("metrics.csv");
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line) || line != header)
+    throw InputError(path + ": missing, or its header is not the scene's '" + header + "'");
+  std::string kept = header + "\n";
+  long found = 0;
+  // Only complete lines count: a kill can leave the last one cut short.
+  while (found < rows && std::getline(in, line) && !in.eof()) {
+    kept += line + "\n";
+    ++found;
+  }
+  if (found < rows)
+    throw InputError(path + ": holds " + std::to_string(found) + " complete rows, the checkpoint expects " +
+                     std::to_string(rows));
+  in.close();
+  out.write_text("metrics.csv", kept);
+  return CheckedFile(path, /*append=*/true);
+}
+
+}  // namespace
+
+void Simulation::run(const OutputDir& out, const RunOptions& options) {
+  // The stencil is needed by the first probe evaluation; it stays valid until particles move
+  // (a physics may key cached grid state to its version).
+  update_stencil();
+  positions_changed_ = false;
+  // On a restart too: whatever a physics derives from the initial state is set up as in a new
+  // run, and the checkpoint then overwrites every field and persistent array.
+  for (auto& physics : physics_) physics->initialize();
+  check_step_budget();
+  LoopState loop;
+  if (options.restart) {
+    loop = restore_checkpoint(out.path());
+  } else {
+    remove_checkpoint(out.path());  // an earlier run's checkpoint would not match these outputs
+    loop.next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;
+    loop.next_metrics = metrics_every_ > 0 ? metrics_every_ : 0;
+  }
+  const std::string header = probes_.header();
+  ParticleFieldWriter writer =
+      options.restart ? reopen_fields(out, loop.frames) : ParticleFieldWriter(out.path(), kDim);
+  CheckedFile metrics = options.restart ? reopen_metrics(out, header, loop.metrics_rows)
+                                        : CheckedFile(out.file("metrics.csv"), /*append=*/false);
+  if (!options.restart) metrics.write(header + '\n');
+  loop.frames = static_cast<long>(writer.frames());
+
+  auto write_frame = [&] {
+    std::vector<FieldView> views;
+    for (const auto& name : output_fields_)
+      views.push_back({name, particles_.field(name).data(), particles_.components(name)});
+    writer.write(time_, step_, particles_.size(), particles_.field("position").data(), views);
+  };
+  auto write_metrics = [&] {
+    std::ostringstream row;
+    row << std::setprecision(12) << time_ << ',' << step_ << ',' << dt_;
+    for (double v : probes_.evaluate()) row << ',' << v;
+    row << '\n';
+    metrics.write(row.str(), at_step(step_, time_));  // a whole row or an error, never half a row
+  };
+
+  const double eps = 1e-9 * end_time_;
+  if (!options.restart) {
+    write_frame();
+    write_metrics();
+    ++loop.frames;
+    ++loop.metrics_rows;
+    if (time_ < end_time_ - eps) loop.next_dt = plan_step(loop);
+  }
+  const auto wall_start = Clock::now();
+  const double time_start = time_;
+  auto last_print = wall_start, last_checkpoint = wall_start;
+  while (time_ < end_time_ - eps) {
+    advance(loop.next_dt);
+    check_finite();
+    const bool metrics_due = metrics_every_ <= 0 || time_ >= loop.next_metrics - eps || time_ >= end_time_ - eps;
+    if (metrics_due) {
+      write_metrics();
+      ++loop.metrics_rows;
+      while (metrics_every_ > 0 && loop.next_metrics <= time_ + eps) loop.next_metrics += metrics_every_;
+    }
+    const bool frame_due = time_ >= loop.next_output - eps;
+    if (frame_due) {
+      write_frame();
+      ++loop.frames;
+      loop.next_output = output_every_ > 0 ? std::min(loop.next_output + output_every_, end_time_) : end_time_;
+      if (loop.next_output <= time_ + eps) loop.next_output = end_time_ + 1;
+    }
+    if (options.progress && log::enabled(log::Level::info) &&
+        std::chrono::duration<double>(Clock::now() - last_print).count() > 2.0) {
+      last_print = Clock::now();
+      const double wall = std::chrono::duration<double>(last_print - wall_start).count();
+      const double eta = wall * (end_time_ - time_) / std::max(time_ - time_start, 1e-300);
+      std::ostringstream line;
+      line << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
+           << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
+      log::info(line.str());
+    }
+    if (time_ >= end_time_ - eps) break;
+
+    // A stop request gets readable outputs of this moment; a restart drops them again (they
+    // are not part of the schedule), so the loop counters above leave them out.
+    const int signal = interrupt_signal();
+    if (signal && !metrics_due) write_metrics();
+    if (signal && !frame_due) write_frame();
+    // The next step is chosen before a checkpoint is written, exactly as without one, and
+    // saved with it: a restart continues with the same step and asks no physics for it.
+    loop.next_dt = plan_step(loop);
+    const bool checkpoint_due =
+        (checkpoint_every_steps_ > 0 && step_ % checkpoint_every_steps_ == 0) ||
+        (checkpoint_every_minutes_ > 0 &&
+         std::chrono::duration<double>(Clock::now() - last_checkpoint).count() >= 60 * checkpoint_every_minutes_);
+    if (signal || checkpoint_due) {
+      save_checkpoint(out.path(), loop, options.scene);
+      last_checkpoint = Clock::now();
+    }
+    if (signal) throw RunInterrupted(signal, time_, step_);
+  }
+  remove_checkpoint(out.path());  // the run is complete: nothing left to resume
+}
+
+}  // namespace frostmpm
