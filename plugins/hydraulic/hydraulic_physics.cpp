@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "frostmpm/models/pore_space.hpp"
+#include "frostmpm/models/two_phase.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
 #include "frostmpm/transfer/nodal_interpolation.hpp"
@@ -45,7 +46,7 @@ ParamSchema HydraulicPhysics::material_schema() const {
   s.real("water_compressibility", "1/Pa", "compressibility of pore water c_w = 1/K_l (INTERFROST: 1e-8)")
       .defaults_to(4.6e-10)
       .at_least(0);
-  s.real("solid_thermal_expansion", "1/K", "volumetric thermal expansion of the soil grains β_s").defaults_to(0.0);
+  declare_solid_thermal_expansion(s);
   s.real("water_thermal_expansion", "1/K", "volumetric thermal expansion of water β_l").defaults_to(0.0);
   s.real("ice_thermal_expansion", "1/K", "volumetric thermal expansion of ice β_c").defaults_to(0.0);
   s.real("shear_modulus", "Pa",
@@ -61,6 +62,7 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   // The body force on the pore water is the scene's gravity; [0, 0] makes pressure the excess
   // (non-hydrostatic) pressure, as in the INTERFROST cases.
   gravity_ = sim.gravity();
+  mass_scaling_ = sim.time_params().real("mass_scaling");
   sim.declare_state_field("porosity", 1, 0.0);
   sim.declare_state_field("pore_pressure", 1, 0.0, /*max_magnitude Pa=*/1e10);
   sim.declare_field("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
@@ -105,7 +107,8 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
                      "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
   const std::size_t n = sim.particle_count(), nodes = sim.grid().node_count();
-  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_})
+  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,
+                  &mobility_})
     v->assign(n, 0.0);
   for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
   if (stabilized_) {
@@ -167,21 +170,35 @@ std::vector<Stage> HydraulicPhysics::stages() {
   const auto p_node = node_pressure_.carried_write(), dp = node_increment_.carried_write();
   // The phase change and the thermal expansion need the temperature when a thermal physics has it.
   const auto T = temperature_field_.optional_read();
-  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T}, {p_node},
+  // With a moving skeleton (its inertia and nodal velocities): the two-phase fractional step.
+  const auto m_s = skeleton_inertia_.optional_read(), vs_star = node_solid_predicted_.optional_read(),
+             vs = node_solid_velocity_.optional_read();
+  Stage drag_stage{"hydraulic.drag", Phase::PredictMomentum, {node_pressure_.read(), v, m_s},
+                   {liquid_drag_.write(), liquid_reaction_.write(), liquid_share_.write()}, [this] { drag(); }};
+  drag_stage.skippable = true;  // only a skeleton that moves reads what it writes
+  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T, m_s}, {p_node},
            [this] { map_to_grid(); }},
-          {"hydraulic.predict", Phase::PredictMomentum, {node_pressure_.read(), v}, {predicted_.write()},
+          std::move(drag_stage),
+          {"hydraulic.predict", Phase::PredictMomentum, {node_pressure_.read(), v, vs_star}, {predicted_.write()},
            [this] { predict(); }},
-          {"hydraulic.pressure", Phase::Pressure, {v_star, node_pressure_.read()}, {dp}, [this] { solve_pressure(); }},
-          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, node_increment_.read(), node_pressure_.read()},
+          {"hydraulic.pressure", Phase::Pressure, {v_star, node_pressure_.read(), vs_star}, {dp},
+           [this] { solve_pressure(); }},
+          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, node_increment_.read(), node_pressure_.read(), vs},
            {velocity_.write(), flux_.write(), p_node}, [this] { correct(); }},
-          {"hydraulic.map_to_particles", Phase::MapToParticles, {node_pressure_.read()}, {pressure_.write()},
-           [this] { map_to_particles(); }}};
+          {"hydraulic.map_to_particles", Phase::MapToParticles, {node_pressure_.read(), node_increment_.read()},
+           {pressure_.write()}, [this] { map_to_particles(); }}};
 }
 
 void HydraulicPhysics::initialize() {
   p_ = &node_pressure_.vector();
   dp_ = &node_increment_.vector();
   temperature_ = temperature_field_.bound();
+  coupled_ = skeleton_inertia_.bound();
+  moving_ = kernel_->particles_move();
+  if (moving_) {
+    const auto p = pressure_.values();
+    carried_.assign(p.begin(), p.end());
+  }
   time_ = kernel_->time();
   update_coefficients();
   project_to_grid();
@@ -215,20 +232,29 @@ void HydraulicPhysics::update_coefficients() {
     n_l_[p] = phi[p] * std::clamp(S[p], 0.0, 1.0);
     const double conductivity = std::max(k_a_[p] * k_r_[p], 1e-300);
     drag_[p] = n_l_[p] * n_l_[p] * rho * reference_gravity_ / conductivity;
-    const double inertia = n_l_[p] * rho;
+    const double inertia = mass_scaling_ * (n_l_[p] * rho);
     xi_[p] = inertia > 0 ? inertia / (inertia + dt_ * drag_[p]) : 0.0;
-    // η = ξ n_l / ρ_l = n_l² / (n_l ρ_l + Δt C_d), written so that Δt → 0 stays finite.
-    eta_[p] = inertia > 0 ? n_l_[p] * n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
     storage_[p] = n_l_[p] * m.compressibility;
+    if (coupled_) {
+      // The two-phase corrector of a skeleton of inertia m_s (models/two_phase.hpp).
+      const auto mobility = two_phase::corrector_mobility(skeleton_inertia_.values()[p], inertia, n_l_[p], drag_[p], dt_);
+      mobility_[p] = mobility.liquid;
+      eta_[p] = two_phase::poisson_coefficient(mobility, n_l_[p], m.zeta * phi[p] * (1.0 - std::clamp(S[p], 0.0, 1.0)));
+      return;
+    }
+    // Rigid skeleton: η = ξ n_l / ρ_l = n_l² / (n_l ρ_l + Δt C_d), written so that Δt → 0 stays finite.
+    eta_[p] = inertia > 0 ? n_l_[p] * n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
   });
 }
 
 /// P2G of the particles' pressure (volume-weighted): the nodal state at the start, and
-/// whenever particles have moved.
+/// whenever particles have moved. Moving particles carry the state (carried_, updated by FLIP
+/// increments): its projection is kept as node_state_, and the pressure field the step works
+/// with has the boundary values on top. Standing particles: the grid is the state.
 void HydraulicPhysics::project_to_grid() {
   const auto& st = kernel_->transfer().stencil();
   const auto vol = volume_.values();
-  const auto p = pressure_.values();
+  const auto p = moving_ ? std::span<const double>(carried_) : pressure_.values();
   std::vector<double> weight(p_->size(), 0.0);
   std::fill(p_->begin(), p_->end(), 0.0);
   const int K = st.per_particle();
@@ -241,6 +267,7 @@ void HydraulicPhysics::project_to_grid() {
     }
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] = weight[i] > 0 ? (*p_)[i] / weight[i] : 0.0; });
+  if (moving_) node_state_ = *p_;
   set_boundary_pressures(time_);
   projected_version_ = st.version();
   grid_valid_ = true;
@@ -305,36 +332,71 @@ void HydraulicPhysics::map_to_grid() {
   set_boundary_pressures(time_);
 }
 
-/// At every particle, v* = (n_l ρ_l v + Δt (−n_l ∇p(x_p) + n_l ρ_l b)) / (n_l ρ_l + Δt C_d):
-/// the liquid momentum with implicit drag and the pressure of the step's start (Eq. 43 with the
-/// gradient form of Eq. 14), at the material points (docs/architecture.md: why there).
+/// At every particle, v* = (m_l v + Δt (−n_l ∇p(x_p) + n_l ρ_l b)) / (m_l + Δt C_d) — the liquid
+/// momentum with implicit drag and the pressure of the step's start (Eq. 43 with the gradient
+/// form of Eq. 14), at the material points (docs/architecture.md: why there) — plus, with a
+/// moving skeleton, (1 − ξ) v_s*(x_p): what the drag makes the liquid follow (models/two_phase.hpp).
 void HydraulicPhysics::predict() {
   const auto& st = kernel_->transfer().stencil();
   const auto v = velocity_.mutable_values();
   auto v_star = predicted_.mutable_values();
+  const auto vs = coupled_ ? node_solid_predicted_.values() : std::span<const double>{};
   parallel_for(kernel_->particle_count(), [&](std::size_t q) {
     const auto grad = nodal_gradient_at(st, q, *p_);
-    const double inertia = n_l_[q] * materials_[material_[q]].water_density, denominator = inertia + dt_ * drag_[q];
+    const double weight = n_l_[q] * materials_[material_[q]].water_density, inertia = mass_scaling_ * weight,
+                 denominator = inertia + dt_ * drag_[q];
     for (int d = 0; d < kDim; ++d)
-      v_star[q * kDim + d] = denominator > 0 ? (inertia * (v[q * kDim + d] + dt_ * gravity_[d]) -
-                                                dt_ * n_l_[q] * grad[d]) / denominator
-                                             : 0.0;
+      v_star[q * kDim + d] =
+          denominator > 0 ? (inertia * v[q * kDim + d] + dt_ * weight * gravity_[d] - dt_ * n_l_[q] * grad[d]) / denominator
+                          : 0.0;
+    if (!coupled_) return;
+    const auto skeleton = kernel_->transfer().vector_at(q, vs);
+    for (int d = 0; d < kDim; ++d) v_star[q * kDim + d] += (1.0 - xi_[q]) * skeleton[d];
   });
 }
 
-/// v = v* − Δt (ξ / ρ_l) ∇Δp(x_p) at every particle (Eq. 47); p_i += Δp_i. The pressure solve
-/// made Σ_p V_p n_l ∇S_ip · v_p balance storage and boundary inflow exactly.
+/// What the skeleton's predictor needs of the liquid, per unit volume: the drag stiffness
+/// k = C_d ξ, the reaction R = k ṽ − f_l (the liquid's share of the mixture forces, its drag
+/// at the free velocity ṽ = v + Δt f_l/m_l) and n_l ξ, the liquid's own share of a pressure
+/// gradient (models/two_phase.hpp).
+void HydraulicPhysics::drag() {
+  const auto& st = kernel_->transfer().stencil();
+  const auto v = velocity_.values();
+  auto k = liquid_drag_.mutable_values();
+  auto R = liquid_reaction_.mutable_values();
+  auto share = liquid_share_.mutable_values();
+  parallel_for(kernel_->particle_count(), [&](std::size_t q) {
+    const auto grad = nodal_gradient_at(st, q, *p_);
+    const double weight = n_l_[q] * materials_[material_[q]].water_density, inertia = mass_scaling_ * weight,
+                 denominator = inertia + dt_ * drag_[q];
+    k[q] = drag_[q] * xi_[q];
+    share[q] = n_l_[q] * xi_[q];
+    for (int d = 0; d < kDim; ++d) {
+      const double f = weight * gravity_[d] - n_l_[q] * grad[d];  // f_l
+      const double k_free = denominator > 0 ? drag_[q] * (inertia * v[q * kDim + d] + dt_ * f) / denominator : 0.0;
+      R[q * kDim + d] = k_free - f;
+    }
+  });
+}
+
+/// v = v* − Δt λ_l ∇Δp(x_p) at every particle (Eq. 47; rigid skeleton: λ_l = ξ/ρ_l); p_i += Δp_i;
+/// the Darcy flux q = n_l (v − v_s). The pressure solve made Σ_p V_p ∇S_ip · q_p balance storage,
+/// sources, the skeleton's volume change and boundary inflow (exactly, for a rigid skeleton).
 void HydraulicPhysics::correct() {
   const auto& st = kernel_->transfer().stencil();
   const auto v_star = predicted_.mutable_values();
   auto v = velocity_.mutable_values();
   auto flux = flux_.mutable_values();
+  const auto vs = coupled_ ? node_solid_velocity_.values() : std::span<const double>{};
   parallel_for(kernel_->particle_count(), [&](std::size_t q) {
     const auto grad = nodal_gradient_at(st, q, *dp_);
-    const double a = dt_ * xi_[q] / materials_[material_[q]].water_density;
+    const double a = coupled_ ? dt_ * mobility_[q]
+                              : dt_ * xi_[q] / (mass_scaling_ * materials_[material_[q]].water_density);
+    std::array<double, kDim> skeleton{};
+    if (coupled_) skeleton = kernel_->transfer().vector_at(q, vs);
     for (int d = 0; d < kDim; ++d) {
       v[q * kDim + d] = v_star[q * kDim + d] - a * grad[d];
-      flux[q * kDim + d] = n_l_[q] * v[q * kDim + d];
+      flux[q * kDim + d] = n_l_[q] * (v[q * kDim + d] - skeleton[d]);
     }
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
@@ -346,6 +408,16 @@ void HydraulicPhysics::map_to_particles() {
   const auto& st = kernel_->transfer().stencil();
   auto p = pressure_.mutable_values();
   parallel_for(p.size(), [&](std::size_t a) { p[a] = nodal_value_at(st, a, *p_); });
+  // Moving particles carry the state: its change since the projection (FLIP, Algorithm 1
+  // step 20), boundary values included; the field the particles show is the grid's.
+  if (moving_)
+    parallel_for(p.size(), [&](std::size_t a) {
+      const auto* nodes = st.nodes(a);
+      const auto* w = st.weights(a);
+      double change = 0;
+      for (int k = 0; k < st.per_particle(); ++k) change += w[k] * ((*p_)[nodes[k]] - node_state_[nodes[k]]);
+      carried_[a] += change;
+    });
 }
 
 // ---- checkpoints and counters ----------------------------------------------------------------------
@@ -356,6 +428,7 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0});
   return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
           {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
+          {"carried_pressure", &carried_},
           {"temperature_at_step_start", &T_prev_}};
 }
 

@@ -101,6 +101,17 @@ class HydraulicPhysics final : public Physics {
   FieldHandle flux_ = FieldHandle::particle("water_flux", kDim, FieldKind::Vector);
   FieldHandle node_pressure_ = FieldHandle::node("pore_pressure");
   FieldHandle node_increment_ = FieldHandle::node("pressure_increment");
+  // Coupling with a moving skeleton (a mechanical physics): what it provides and what the
+  // liquid hands back (models/two_phase.hpp)
+  FieldHandle skeleton_inertia_ = FieldHandle::particle("skeleton_inertia");
+  FieldHandle node_solid_predicted_ = FieldHandle::node("solid_velocity_predicted", kDim);
+  FieldHandle node_solid_velocity_ = FieldHandle::node("solid_velocity", kDim);
+  FieldHandle liquid_drag_ = FieldHandle::particle("liquid_drag");
+  FieldHandle liquid_reaction_ = FieldHandle::particle("liquid_reaction", kDim, FieldKind::Vector);
+  FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share");
+  bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
+  bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
+  double mass_scaling_ = 1;
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
@@ -110,6 +121,9 @@ class HydraulicPhysics final : public Physics {
   // ---- particles: per-step coefficients
   std::span<const std::uint16_t> material_;  ///< material index of every particle (the kernel's)
   std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
+  std::vector<double> mobility_;  ///< coupled: λ_l, the liquid's velocity change per Δt ∇Δp
+  std::vector<double> carried_;     ///< moving particles: the pressure each carries (FLIP)
+  std::vector<double> node_state_;  ///< moving particles: its projection at the step's start
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
   std::vector<double> source_, S_prev_, T_prev_;
@@ -164,6 +178,8 @@ class HydraulicPhysics final : public Physics {
   void project_to_grid();
   void map_to_grid();
   void predict();
+  /// Coupled: the drag stiffness C_d ξ, the reaction k ṽ − f_l and the share n_l ξ the skeleton needs.
+  void drag();
   void solve_pressure();
   void correct();
   void map_to_particles();

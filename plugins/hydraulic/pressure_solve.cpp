@@ -35,19 +35,38 @@ void HydraulicPhysics::assemble() {
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
   const int K = st.per_particle();
   const auto v_star = predicted_.values();
+  // A moving skeleton: the relative flux n_l (v_l* − v_s*) crosses the test functions' gradients
+  // and (1 − ζ n_c) ∇·v_s* changes the volume (Eq. 56; the divergence at the particle, not
+  // integrated by parts, so a free surface needs no boundary term).
+  const auto vs = coupled_ ? node_solid_predicted_.values() : std::span<const double>{};
+  const auto phi = porosity_.values();
   kernel_->transfer().scatter([&](std::size_t q) {
     const auto* n = st.nodes(q);
     const auto* w = st.weights(q);
     const auto* g = st.gradients(q);
     const int* slot = graph_.scatter.data() + q * K * K;
     const double k = vol[q] * dt_ * eta_[q];
+    double relative[kDim];
     const double* v = v_star.data() + q * kDim;
+    double skeleton_volume = 0;  // V (1 − ζ n_c) ∇·v_s*
+    if (coupled_) {
+      const auto skeleton = kernel_->transfer().vector_at(q, vs);
+      const auto grad_vs = kernel_->transfer().vector_gradient_at(q, vs);
+      for (int d = 0; d < kDim; ++d) {
+        relative[d] = v[d] - skeleton[d];
+        skeleton_volume += grad_vs[d][d];
+      }
+      const double n_c = phi[q] - n_l_[q];
+      skeleton_volume *= vol[q] * (1.0 - materials_[material_[q]].zeta * n_c);
+      v = relative;
+    }
     const double flux = vol[q] * n_l_[q], storage = vol[q] * storage_[q] / dt_, source = vol[q] * source_[q];
     for (int a = 0; a < K; ++a) {
       values_[slot[a * K + a]] += w[a] * storage;  // M lumped on the diagonal
       double divergence = 0;
       for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * v[d];
       rhs_[n[a]] += flux * divergence - w[a] * source;
+      if (coupled_) rhs_[n[a]] -= w[a] * skeleton_volume;
       if (k == 0) continue;
       for (int b = 0; b < K; ++b) {
         double dot = 0;

@@ -10,7 +10,7 @@ namespace frostmpm::thermal {
 ParamSchema material_schema() {
   ParamSchema s;
   declare_pore_space_keys(s);
-  s.real("solid_density", "kg/m^3", "intrinsic density of the solid grains ρ_s").above(0);
+  declare_solid_density(s);
   s.real("solid_heat_capacity", "J/kg/K", "specific heat capacity of the solid c_s").above(0);
   s.real("solid_conductivity", "W/m/K", "thermal conductivity of the solid κ_s").above(0);
   s.real("water_heat_capacity", "J/kg/K", "specific heat capacity of water c_l").defaults_to(4182.0).above(0);

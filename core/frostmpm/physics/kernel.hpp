@@ -106,6 +106,10 @@ class Kernel {
   virtual double time() const = 0;
   virtual double dt() const = 0;
   virtual long step() const = 0;
+  /// True when some stage writes the particle positions (valid from initialize() on): the
+  /// kernel then recomputes stencils, volumes and GIMP domains every step, and grid state
+  /// derived from particles must be derived again.
+  virtual bool particles_move() const = 0;
   /// "particle 12 at (0.5, 0.25) in regions.0 (material 'soil')": for messages.
   virtual std::string describe_particle(std::size_t p) const = 0;
 };

@@ -48,6 +48,13 @@ std::string TimeFunction::forms_help() {
          "2*sin(2*pi*t/86400)\"} of time t in seconds";
 }
 
+TimeFunction TimeFunction::scaled(double factor) const {
+  TimeFunction out = *this;
+  if (kind_ == Kind::Constant) out.value_ = factor * value_;
+  else out.scale_ = factor * scale_;
+  return out;
+}
+
 TimeFunction TimeFunction::constant(double v) {
   TimeFunction f;
   f.kind_ = Kind::Constant;

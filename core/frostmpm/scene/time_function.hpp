@@ -46,7 +46,9 @@ class TimeFunction {
 
   /// Value at time t. With `extrapolation: error`, a t outside the table is an InputError
   /// pointing at the table in the scene.
-  double operator()(double t) const { return kind_ == Kind::Constant ? value_ : evaluate(t); }
+  double operator()(double t) const { return kind_ == Kind::Constant ? value_ : scale_ * evaluate(t); }
+  /// The same function times `factor` (e.g. a pressure turned into a traction along a normal).
+  TimeFunction scaled(double factor) const;
 
   Kind kind() const { return kind_; }
   /// True when the value never depends on t (a constant, an expression without t, a table of
@@ -64,6 +66,7 @@ class TimeFunction {
   struct Impl;
   Kind kind_ = Kind::Constant;
   double value_ = 0;                  ///< the constant, for Kind::Constant
+  double scale_ = 1;                  ///< factor on a table or expression (scaled())
   std::shared_ptr<const Impl> impl_;  ///< table or expression, shared between copies
 
   double evaluate(double t) const;

@@ -3,6 +3,7 @@
 #include "frostmpm/parallel/parallel.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace frostmpm {
 
@@ -25,8 +26,27 @@ long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const dou
     bool inside = true;
     for (int d = 0; d < Dim; ++d) {
       const double h = grid.spacing[d];
-      const double xi = (positions[p * Dim + d] - grid.origin[d]) / h;
-      base[d] = shape_1d(kind_, xi, h, half_sizes[p * Dim + d] / h, w[d].data(), g[d].data());
+      double xi = (positions[p * Dim + d] - grid.origin[d]) / h;
+      double half = half_sizes[p * Dim + d] / h;
+      // GIMP integrates over the particle domain inside the grid, Ω_p ∩ Ω (paper Eq. 58): a domain
+      // that reaches past the grid's edge (a particle pressed against a fixed boundary) is clipped
+      // to it, which keeps the partition of unity. A domain wholly outside has left the grid.
+      if (kind_ == ShapeKind::Gimp) {
+        // Beyond round-off (shape_1d's own tolerance): a domain that ends on the edge, as every
+        // lattice particle's does, keeps its weights.
+        const double edge_lo = -grid.ghost_layers, edge_hi = grid.cells[d] + grid.ghost_layers;
+        const double tol = 16.0 * std::numeric_limits<double>::epsilon() * (std::abs(xi) + 2.0);
+        if (xi - half < edge_lo - tol || xi + half > edge_hi + tol) {
+          const double lo = std::max(xi - half, edge_lo), hi = std::min(xi + half, edge_hi);
+          if (!(hi > lo)) {
+            inside = false;
+            break;
+          }
+          xi = 0.5 * (lo + hi);
+          half = 0.5 * (hi - lo);
+        }
+      }
+      base[d] = shape_1d(kind_, xi, h, half, w[d].data(), g[d].data());
       // A support node past the grid is harmless when its weight is zero (GIMP particles at
       // the domain edge); it is then pointed at a valid node.
       for (int k = 0; k < width_; ++k) {

@@ -152,9 +152,11 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       }
       if (top.empty()) throw item.error("no particle lies within x_range");
       probe->component = kDim - 1;
+      // The surface is the top of these particles' domains: their centres sit half a particle
+      // below it, and follow it only where the strain vanishes.
       for (const auto& [_, p] : top) {
         probe->particles.push_back(p);
-        probe->start.push_back(positions[p * kDim + kDim - 1]);
+        probe->start.push_back(positions[p * kDim + kDim - 1] + half[p * kDim + kDim - 1]);
       }
       item.finish({"type", "name", "x_range"});
     } else if (probe->type == "reaction") {
@@ -261,9 +263,12 @@ std::vector<double> Probes::evaluate() const {
       const std::size_t p = probe->particles.front();
       out.push_back(positions[p * kDim + probe->component] - probe->start.front());
     } else if (probe->type == "settlement") {
+      const auto half = particles.field("half_size");
       double sum = 0;
-      for (std::size_t k = 0; k < probe->particles.size(); ++k)
-        sum += probe->start[k] - positions[probe->particles[k] * kDim + probe->component];
+      for (std::size_t k = 0; k < probe->particles.size(); ++k) {
+        const std::size_t p = probe->particles[k];
+        sum += probe->start[k] - (positions[p * kDim + probe->component] + half[p * kDim + probe->component]);
+      }
       out.push_back(sum / double(probe->particles.size()));
     } else if (probe->type == "reaction") {
       out.push_back(sources_.reaction(probe->boundary)[probe->component]);

@@ -6,8 +6,9 @@
 //   isotherm         distance along a segment to the first crossing of a level
 //   displacement     one component of the displacement of the material point that started
 //                    nearest to `point` (it is followed as it moves)
-//   settlement       mean downward displacement of the material's top surface (the top particle
-//                    of every particle column, optionally within x_range), m, positive down
+//   settlement       mean downward displacement of the material's top surface (the top of the GIMP
+//                    domain of the top particle of every particle column, optionally within
+//                    x_range), m, positive down
 //   reaction         one component of the force a boundary condition (named with `name:`)
 //                    exerts on the material, N per m of thickness in 2-D
 #include <array>

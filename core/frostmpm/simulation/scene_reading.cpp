@@ -79,6 +79,13 @@ void Simulation::read_time(const ConfigNode& node) {
   s.real("dt_max", "s", "upper bound on an automatic step; 0 = none").defaults_to(0.0).at_least(0);
   s.integer("max_steps", "most steps, metrics rows or field frames a run may take; a scene needing more is refused")
       .defaults_to(kDefaultMaxSteps).at_least(1);
+  s.real("mass_scaling", "-",
+         "factor on every inertia (skeleton and pore water; not on weight): an explicit skeleton's stable step "
+         "grows with its square root, for slow processes (consolidation, thaw) where inertia plays no part; "
+         "run.json's mechanical.kinetic_to_work_max says whether it stayed negligible")
+      .defaults_to(1.0)
+      .at_least(1)
+      .at_most(1e12);
   const ParamSet p = parse_params(s, node);
   end_time_ = p.real("end");
   fixed_dt_ = p.real("dt");

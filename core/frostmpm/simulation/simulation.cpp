@@ -14,6 +14,7 @@
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
 #include "frostmpm/parallel/parallel.hpp"
+#include "frostmpm/scene/expression.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/run_budget.hpp"
 
@@ -176,27 +177,73 @@ std::vector<PersistentArray> Simulation::carried_node_fields() {
   return arrays;
 }
 
+/// Regions' `initial:` values: a state field, or one component of a vector state field
+/// ("solid_velocity.x"), set to a number or to an expression of the position,
+/// {expression: "0.1*sin(pi*x/50)"} with variables x, y.
 void Simulation::apply_initial_values() {
   std::vector<std::string> settable;
-  for (const auto& [name, _] : state_defaults_) settable.push_back(name);
+  for (const auto& [name, _] : state_defaults_) {
+    settable.push_back(name);
+    for (const auto& part : component_names(particles_.kind(name), particles_.components(name)))
+      settable.push_back(name + "." + part);
+  }
+  const auto pos = particles_.field("position");
   for (auto& init : region_inits_) {
     if (!init.node) continue;
     const ConfigNode& node = *init.node;
     node.reject_unknown(settable);
     for (const auto& key : node.keys()) {
       const ConfigNode entry = node.child(key);
-      const double value = entry.as_real();
-      // A material parameter set per region obeys the material's range (porosity in (0, 1)).
-      if (const ParamSpec* spec = material_schema_.find(key); spec && !spec->in_range(value))
-        throw entry.error(number_text(value) + " is outside the range of material parameter '" + key +
-                          "'; valid: " + spec->range_text());
-      if (std::abs(value) > state_bounds_.at(key))
-        throw entry.error(number_text(value) + " is beyond the plausible magnitude " +
-                          number_text(state_bounds_.at(key)) + " of '" + key + "'");
-      auto column = particles_.field(key);
-      const int c = particles_.components(key);
-      for (std::size_t p = init.range.begin; p < init.range.end; ++p)
-        for (int k = 0; k < c; ++k) column[p * c + k] = value;
+      // The field and the components the key sets.
+      std::string field = key;
+      int first = 0, count = 0;
+      if (const auto dot = key.rfind('.'); dot != std::string::npos && !particles_.has(key)) {
+        field = key.substr(0, dot);
+        const auto parts = component_names(particles_.kind(field), particles_.components(field));
+        first = static_cast<int>(std::find(parts.begin(), parts.end(), key.substr(dot + 1)) - parts.begin());
+        count = 1;
+      } else {
+        count = particles_.components(field);
+      }
+      const ParamSpec* spec = material_schema_.find(field);
+      auto check = [&](double value, const std::string& where) {
+        // A material parameter set per region obeys the material's range (porosity in (0, 1)).
+        if (!std::isfinite(value))
+          throw entry.error(where + "is not a finite number");
+        if (spec && !spec->in_range(value))
+          throw entry.error(where + number_text(value) + " is outside the range of material parameter '" + field +
+                            "'; valid: " + spec->range_text());
+        if (std::abs(value) > state_bounds_.at(field))
+          throw entry.error(where + number_text(value) + " is beyond the plausible magnitude " +
+                            number_text(state_bounds_.at(field)) + " of '" + field + "'");
+      };
+      auto column = particles_.field(field);
+      const int c = particles_.components(field);
+      if (entry.is_map()) {
+        const ConfigNode text = entry.child("expression");
+        entry.finish({"expression"});
+        Expression f;
+        try {
+          f = Expression::compile(text.as_string(), {"x", "y"});
+        } catch (const ExpressionError& e) {
+          throw text.error("expression '" + text.as_string() + "' : " + e.what());
+        }
+        for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
+          const double at[2] = {pos[p * kDim], pos[p * kDim + 1]};
+          const double value = f.evaluate(at);
+          if (!std::isfinite(value) || (spec && !spec->in_range(value)) || std::abs(value) > state_bounds_.at(field)) {
+            std::ostringstream where;
+            where << "at (" << at[0] << ", " << at[1] << ") the expression gives ";
+            check(value, where.str());
+          }
+          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+        }
+      } else {
+        const double value = entry.as_real();
+        check(value, "");
+        for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+      }
     }
   }
 }
@@ -423,6 +470,9 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   LoopState loop;
   if (options.restart) {
     loop = restore_checkpoint(out.path());
+    // Moving particles: the stencil of the restored positions and domains, as the step after
+    // the checkpoint would have made it.
+    positions_changed_ = moving_;
   } else {
     remove_checkpoint(out.path());  // an earlier run's checkpoint would not match these outputs
     loop.next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;

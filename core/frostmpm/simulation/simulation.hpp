@@ -111,9 +111,7 @@ class Simulation final : public Kernel<kDim> {
   /// How often this run was restarted from a checkpoint.
   long restarts() const { return restarts_; }
   const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
-  /// True when some stage writes the particle positions: the kernel then recomputes stencils,
-  /// particle volumes and GIMP domains every step.
-  bool particles_move() const { return moving_; }
+  bool particles_move() const override { return moving_; }
 
   /// Advances one step of size dt (exposed for tests and benchmarks).
   void advance(double dt);

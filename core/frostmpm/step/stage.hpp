@@ -147,6 +147,9 @@ struct Stage {
   std::vector<FieldRef> reads;
   std::vector<FieldRef> writes;
   std::function<void()> run;
+  /// Runs only when another stage of the scene reads something it writes (e.g. what a physics
+  /// hands to a partner physics the scene may not have): otherwise the kernel drops it.
+  bool skippable = false;
 };
 
 }  // namespace frostmpm

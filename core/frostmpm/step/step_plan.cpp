@@ -111,6 +111,24 @@ StepPlan StepPlan::resolve(std::vector<Declared> declared, const std::vector<std
         if (list == &d.stage.writes && f.carried) carried.insert(key(f));
       }
 
+  // Skippable stages nobody needs leave the step: none of their writes is read by another stage
+  // that stays (repeated, since dropping one can make another unneeded).
+  for (bool dropped = true; dropped;) {
+    dropped = false;
+    for (std::size_t i = 0; i < declared.size(); ++i) {
+      if (!declared[i].stage.skippable) continue;
+      bool needed = false;
+      for (std::size_t j = 0; j < declared.size() && !needed; ++j)
+        if (j != i)
+          for (const auto& f : declared[i].stage.writes) needed = needed || touches(declared[j].stage.reads, f);
+      if (!needed) {
+        declared.erase(declared.begin() + static_cast<std::ptrdiff_t>(i));
+        dropped = true;
+        break;
+      }
+    }
+  }
+
   // Optional reads nobody provides leave the step: no writer in any stage, and not a particle
   // field the scene has.
   {

@@ -1,0 +1,77 @@
+// Isotropic linear elasticity in rate form (hypoelastic, paper Eq. 28 with D the Hooke tensor):
+//   Δσ′ = λ tr(Δε) I + 2G Δε,  G = E / (2(1 + ν)),  λ = E ν / ((1 + ν)(1 − 2ν)),
+// with a Young's modulus that may grow with the ice saturation S_c (frozen soil stiff, thawed
+// soil soft): E(S_c) = E + (E_frozen − E) S_c, ν fixed. In rate form a change of stiffness acts
+// on the increments only: ice melting at constant strain changes no stress.
+#include <algorithm>
+#include <cmath>
+
+#include "frostmpm/models/mechanical_model.hpp"
+#include "frostmpm/plugin/plugin_api.hpp"
+
+namespace frostmpm {
+
+class LinearElastic final : public MechanicalModel {
+ public:
+  static constexpr const char* kName = "linear_elastic";
+  static constexpr const char* kDoc =
+      "isotropic linear elasticity (Hooke, rate form); optional Young's modulus growing with ice saturation";
+
+  static ParamSchema schema() {
+    ParamSchema s;
+    s.real("youngs_modulus", "Pa", "Young's modulus E of the (unfrozen) skeleton").above(0).at_most(1e13);
+    s.real("poisson_ratio", "-", "Poisson's ratio ν (−1 < ν < 0.5)").above(-1).below(0.5);
+    s.real("frozen_youngs_modulus", "Pa",
+           "Young's modulus at full ice saturation S_c = 1, interpolated linearly in S_c; 0: the same as "
+           "youngs_modulus (no ice dependence)")
+        .defaults_to(0.0)
+        .at_least(0)
+        .at_most(1e13);
+    return s;
+  }
+
+  explicit LinearElastic(const ParamSet& p)
+      : E_(p.real("youngs_modulus")), nu_(p.real("poisson_ratio")), E_frozen_(p.real("frozen_youngs_modulus")) {
+    if (E_frozen_ == 0) E_frozen_ = E_;
+  }
+
+  void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const override {
+    const std::size_t n = in.stress_start.size() / 6;
+    const bool ice = !in.ice_saturation.empty();
+    for (std::size_t p = 0; p < n; ++p) {
+      const double E = ice ? modulus(in.ice_saturation[p]) : E_;
+      const double G = E / (2.0 * (1.0 + nu_)), lambda = E * nu_ / ((1.0 + nu_) * (1.0 - 2.0 * nu_));
+      const double* de = in.strain_increment.data() + 6 * p;
+      const double* s0 = in.stress_start.data() + 6 * p;
+      double* s = out.stress.data() + 6 * p;
+      const double volumetric = lambda * (de[0] + de[1] + de[2]);
+      for (int i = 0; i < 3; ++i) s[i] = s0[i] + volumetric + 2.0 * G * de[i];
+      for (int i = 3; i < 6; ++i) s[i] = s0[i] + 2.0 * G * de[i];
+      if (!out.tangent.empty()) {
+        double* D = out.tangent.data() + 36 * p;
+        std::fill(D, D + 36, 0.0);
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) D[6 * i + j] = lambda;
+          D[6 * i + i] += 2.0 * G;
+        }
+        for (int i = 3; i < 6; ++i) D[6 * i + i] = 2.0 * G;
+      }
+      if (!out.p_wave_modulus.empty()) out.p_wave_modulus[p] = lambda + 2.0 * G;
+      if (!out.shear_modulus.empty()) out.shear_modulus[p] = G;
+    }
+  }
+
+  double max_p_wave_modulus() const override {
+    const double E = std::max(E_, E_frozen_);
+    return E * (1.0 - nu_) / ((1.0 + nu_) * (1.0 - 2.0 * nu_));
+  }
+
+ private:
+  double modulus(double ice_saturation) const { return E_ + (E_frozen_ - E_) * std::clamp(ice_saturation, 0.0, 1.0); }
+
+  double E_, nu_, E_frozen_;
+};
+
+FROSTMPM_REGISTER(MechanicalModel, LinearElastic)
+
+}  // namespace frostmpm

@@ -1,0 +1,178 @@
+// Boundary conditions of the skeleton, on grid nodes:
+//   {type: fixed, nodes: ...}                       every velocity component 0
+//   {type: roller, nodes: {face: x_min}}            the face's normal component 0 (or `component: x`)
+//   {type: velocity, nodes: ..., x: v(t), y: ...}   the components given follow time functions
+//   {type: traction, nodes: {face: ...}, normal: t(t), shear: t(t)}   or x: / y: components [Pa]
+//   {type: surcharge, nodes: {face: y_max, range: [a, b]}, value: q(t)}  a pressure pushing in
+// Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
+// ∂Ω_v) and record the force they exert on the material (reaction probes). A traction acting
+// on a component a velocity condition prescribes is refused: the two would fight.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mechanical_physics.hpp"
+
+namespace frostmpm::mechanical {
+
+namespace {
+
+constexpr double kMaxVelocity = 1e4;   // m/s
+constexpr double kMaxTraction = 1e10;  // Pa
+
+const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
+
+template <int Dim>
+int read_axis(const ConfigNode& node) {
+  const std::string c = node.as_string();
+  for (int d = 0; d < Dim; ++d)
+    if (c == axis_name(d)) return d;
+  throw node.error("unknown component '" + c + "'; valid: x, y" + std::string(Dim == 3 ? ", z" : ""));
+}
+
+}  // namespace
+
+template <int Dim>
+void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
+  const double end = kernel.end_time();
+  const std::size_t nodes = kernel.grid().node_count();
+  constraint_owner_.assign(nodes * Dim, -1);
+  auto on_nodes = [](const BoundaryCondition* bc) {
+    if (bc->on_particles)
+      throw bc->node->error(bc->type + " acts on grid nodes: use nodes: {face: ...} or {box: ...}");
+  };
+  auto add_velocity = [&](BoundaryCondition* bc, std::array<std::optional<TimeFunction>, Dim> value) {
+    VelocityCondition c;
+    c.bc = bc;
+    c.nodes = bc->nodes;
+    c.value = std::move(value);
+    const int index = static_cast<int>(velocity_bcs_.size());
+    for (std::size_t i : c.nodes)
+      for (int d = 0; d < Dim; ++d)
+        if (c.value[d] && constraint_owner_[i * Dim + d] < 0) constraint_owner_[i * Dim + d] = index;
+    velocity_bcs_.push_back(std::move(c));
+  };
+  for (auto* bc : kernel.boundary_conditions("fixed")) {
+    on_nodes(bc);
+    std::array<std::optional<TimeFunction>, Dim> value;
+    for (int d = 0; d < Dim; ++d) value[d] = TimeFunction::constant(0.0);
+    add_velocity(bc, std::move(value));
+  }
+  for (auto* bc : kernel.boundary_conditions("roller")) {
+    on_nodes(bc);
+    int axis = bc->face_axis;
+    if (auto component = bc->node->optional_child("component")) axis = read_axis<Dim>(*component);
+    if (axis < 0) throw bc->node->error("a roller on a node box needs `component:` (the axis held fixed)");
+    std::array<std::optional<TimeFunction>, Dim> value;
+    value[axis] = TimeFunction::constant(0.0);
+    add_velocity(bc, std::move(value));
+  }
+  for (auto* bc : kernel.boundary_conditions("velocity")) {
+    on_nodes(bc);
+    std::array<std::optional<TimeFunction>, Dim> value;
+    bool any = false;
+    for (int d = 0; d < Dim; ++d)
+      if (auto v = bc->node->optional_child(axis_name(d))) {
+        value[d] = TimeFunction::read(*v, kMaxVelocity, end);
+        any = true;
+      }
+    if (!any)
+      throw bc->node->error("a velocity condition prescribes at least one component: x, y" +
+                            std::string(Dim == 3 ? ", z" : "") + " (m/s, a constant, table or expression)");
+    add_velocity(bc, std::move(value));
+  }
+  auto add_traction = [&](BoundaryCondition* bc, std::array<TimeFunction, Dim> value) {
+    const bool face = bc->face_axis >= 0;
+    if (!face) throw bc->node->error(bc->type + " acts on a grid face: use nodes: {face: ..., range: [from, to]}");
+    TractionCondition c;
+    c.bc = bc;
+    c.nodes = bc->nodes;
+    c.areas = bc->node_areas;
+    c.value = std::move(value);
+    for (int d = 0; d < Dim; ++d) {
+      if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
+      for (std::size_t i : c.nodes)
+        if (constraint_owner_[i * Dim + d] >= 0) {
+          const auto* other = velocity_bcs_[std::size_t(constraint_owner_[i * Dim + d])].bc;
+          throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component of nodes that the " +
+                                other->label() + " prescribes: a velocity condition and a traction cannot both act on "
+                                "one component");
+        }
+    }
+    traction_bcs_.push_back(std::move(c));
+  };
+  for (auto* bc : kernel.boundary_conditions("traction")) {
+    on_nodes(bc);
+    std::array<TimeFunction, Dim> value;
+    bool by_components = false;
+    for (int d = 0; d < Dim; ++d) by_components = by_components || bc->node->has(axis_name(d));
+    const bool by_normal = bc->node->has("normal") || bc->node->has("shear");
+    if (by_components == by_normal)
+      throw bc->node->error("give the traction either as normal: (and in 2-D shear:) or as components x:, y:" +
+                            std::string(Dim == 3 ? ", z:" : "") + " (Pa, tension positive)");
+    if (by_components) {
+      for (int d = 0; d < Dim; ++d)
+        if (auto t = bc->node->optional_child(axis_name(d))) value[d] = TimeFunction::read(*t, kMaxTraction, end);
+    } else {
+      if (bc->face_axis < 0) throw bc->node->error("normal: and shear: need a face target: nodes: {face: ...}");
+      if (auto t = bc->node->optional_child("normal")) {
+        // Along the outward normal: +axis on a max face, −axis on a min face.
+        const TimeFunction f = TimeFunction::read(*t, kMaxTraction, end);
+        value[bc->face_axis] = bc->face_side > 0 ? f : f.scaled(-1.0);
+      }
+      if (auto t = bc->node->optional_child("shear")) {
+        if (Dim != 2) throw t->error("shear: is a 2-D key; in 3-D give the traction by components x:, y:, z:");
+        value[1 - bc->face_axis] = TimeFunction::read(*t, kMaxTraction, end);
+      }
+    }
+    add_traction(bc, std::move(value));
+  }
+  for (auto* bc : kernel.boundary_conditions("surcharge")) {
+    on_nodes(bc);
+    if (bc->face_axis < 0) throw bc->node->error("surcharge acts on a grid face: use nodes: {face: ...}");
+    const TimeFunction q = TimeFunction::read(bc->node->child("value"), kMaxTraction, end);
+    std::array<TimeFunction, Dim> value;
+    // A pressure pushes into the material: against the outward normal.
+    value[bc->face_axis] = bc->face_side > 0 ? q.scaled(-1.0) : q;
+    add_traction(bc, std::move(value));
+  }
+}
+
+template <int Dim>
+void MechanicalPhysics<Dim>::constrain(std::vector<double>& v, double t, double force_scale) {
+  for (std::size_t k = 0; k < velocity_bcs_.size(); ++k) {
+    auto& c = velocity_bcs_[k];
+    for (int d = 0; d < Dim; ++d) {
+      if (!c.value[d]) continue;
+      const double value = (*c.value[d])(t);
+      for (std::size_t i : c.nodes) {
+        if (constraint_owner_[i * Dim + d] != static_cast<int>(k) || mass_[i] <= 0) continue;
+        double& vi = v[i * Dim + d];
+        // The force that holds the component: (m + Δt D)(v_prescribed − v_free)/Δt.
+        if (force_scale > 0) c.reaction[d] += force_scale * (mass_[i] + dt_ * drag_[i]) * (value - vi) / dt_;
+        vi = value;
+      }
+    }
+  }
+}
+
+template <int Dim>
+std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const BoundaryCondition& bc) const {
+  for (const auto& c : velocity_bcs_)
+    if (c.bc == &bc) return c.reaction;
+  for (const auto& c : traction_bcs_)
+    if (c.bc == &bc) return c.applied;
+  return std::nullopt;
+}
+
+// The members defined in this file, for both dimensions (the class itself is instantiated in
+// mechanical_physics.cpp).
+#define FROSTMPM_MECHANICAL_BOUNDARIES(D)                                                          \
+  template void MechanicalPhysics<D>::read_boundaries(Kernel<D>&);                                 \
+  template void MechanicalPhysics<D>::constrain(std::vector<double>&, double, double);             \
+  template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const;
+FROSTMPM_MECHANICAL_BOUNDARIES(2)
+FROSTMPM_MECHANICAL_BOUNDARIES(3)
+#undef FROSTMPM_MECHANICAL_BOUNDARIES
+
+}  // namespace frostmpm::mechanical

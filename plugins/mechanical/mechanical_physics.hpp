@@ -1,0 +1,127 @@
+#pragma once
+// The solid skeleton (solid grains and ice, paper Sec. 2.3, 3.3, 4.1–4.4, Algorithm 1): the
+// momentum balance of the mixture with gravity and tractions, effective stress σ′ (tension
+// positive; total σ = σ′ − p_l I), the objective (Jaumann) stress rate, strain increments from
+// the nodal solid velocity, porosity from the conserved solid volume and the trapezoidal
+// position update. Written once for 2-D (plane strain) and 3-D; stress is always 3×3.
+//
+// Step (update stress first, as Algorithm 1):
+//   map_to_grid       P2G of inertia and momentum; velocity conditions on v^k; at every particle
+//                     L = Σ_i v_i ⊗ ∇S_ip, Δε = sym(L) Δt − β_s ΔT/3 I, the Jaumann rotation of
+//                     σ′ by W = skew(L), the constitutive model (per material range), F ← (I + LΔt) F,
+//                     porosity from the solid volume, the skeleton's inertia for the liquid;
+//   predict           nodal forces −Σ V ∇S·(σ′ − p I) + Σ S V ρ_m g + tractions (+ the liquid's
+//                     reaction and its implicit drag when a hydraulic physics runs), local damping,
+//                     v* = (m v + Δt f)/(m + Δt D); velocity conditions on v* (their reaction kept);
+//   correct           with a pressure increment: Δv = −Δt Σ S V (1 − n_l ξ) ∇Δp / (m + Δt D)
+//                     (the skeleton's share of the two-phase corrector, models/two_phase.hpp);
+//   map_to_particles  FLIP/PIC blend of the velocity; x += Δt Σ S (v_i^k + ½ Δv_i) (Alg. 1 step 21,
+//                     the particle's v^k taken from the grid).
+// The kernel derives particle volumes V = V0 det F and GIMP domains from the deformation
+// gradient and recomputes the stencils every step, since this physics writes `position`.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "frostmpm/models/mechanical_model.hpp"
+#include "frostmpm/physics/physics.hpp"
+#include "frostmpm/scene/time_function.hpp"
+
+namespace frostmpm::mechanical {
+
+template <int Dim>
+class MechanicalPhysics final : public Physics {
+ public:
+  static ParamSchema schema();
+  explicit MechanicalPhysics(const ParamSet& p);
+
+  ParamSchema material_schema() const override;
+  std::vector<ModelSlot> material_models() const override {
+    return {{"mechanical_model", MechanicalModel::kKind, true}};
+  }
+  std::vector<std::string> boundary_types() const override {
+    return {"fixed", "roller", "velocity", "traction", "surcharge"};
+  }
+
+  void setup(Kernel<Dim>& kernel) override;
+  std::vector<Stage> stages() override;
+  void initialize() override;
+  double stable_time_step() const override;
+  void begin_step(double time, double dt) override;
+  std::vector<PersistentArray> persistent_state() override;
+  void restored() override;
+  std::optional<std::array<double, 3>> reaction(const BoundaryCondition& bc) const override;
+  std::vector<std::pair<std::string, double>> statistics() const override;
+
+ private:
+  /// A velocity condition: the components it prescribes (value at time t), on nodes.
+  struct VelocityCondition {
+    const BoundaryCondition* bc = nullptr;
+    std::vector<std::size_t> nodes;
+    std::array<std::optional<TimeFunction>, Dim> value;
+    std::array<double, 3> reaction{};  ///< force on the material over the last step [N (per m in 2-D)]
+  };
+  /// A traction condition: force per area on face nodes.
+  struct TractionCondition {
+    const BoundaryCondition* bc = nullptr;
+    std::vector<std::size_t> nodes;
+    std::vector<double> areas;
+    std::array<TimeFunction, Dim> value;  ///< traction vector components [Pa]
+    std::array<double, 3> applied{};      ///< force it applied over the last step
+  };
+  struct MaterialData {
+    std::shared_ptr<MechanicalModel> model;
+    std::string model_name;
+    std::vector<std::size_t> variables;  ///< index of each of the model's internal variables in variables_
+    double solid_density = 0, water_density = 0, ice_density = 0, expansion = 0, k0 = 0;
+  };
+
+  // ---- configuration
+  ParamSet params_;
+  Kernel<Dim>* kernel_ = nullptr;
+  double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
+  bool jaumann_ = true, geostatic_ = false;
+  std::vector<MaterialData> materials_;
+  std::vector<VelocityCondition> velocity_bcs_;
+  std::vector<TractionCondition> traction_bcs_;
+  std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition, or −1
+
+  // ---- fields (bound by the kernel once the step is resolved)
+  FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,
+      inertia_, temperature_, saturation_, pore_pressure_, liquid_drag_, liquid_reaction_, liquid_share_;
+  FieldHandle node_velocity_, node_predicted_, node_increment_, node_pressure_;
+  std::vector<std::string> variable_names_;                 ///< internal variables of every model, once each
+  std::vector<FieldHandle> variables_, variables_start_;    ///< their particle fields
+
+  // ---- per particle (scratch and the step's moduli)
+  std::vector<double> strain_increment_, rotated_, state_in_, state_out_, wave_modulus_, previous_T_;
+  std::vector<double> particle_mass_;  ///< without pore-water flow: each particle's constant mass
+  std::vector<std::uint8_t> failed_;
+  // ---- per node
+  std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
+
+  // ---- step and counters
+  double time_ = 0, dt_ = 0;
+  bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
+  double kinetic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  std::vector<double> saved_scalars_;
+
+  void read_boundaries(Kernel<Dim>& kernel);
+  /// Sets the prescribed components of the nodal velocity `v` at time t; with `force_scale` > 0
+  /// adds each condition's reaction (force_scale · (v_prescribed − v_free) per component).
+  void constrain(std::vector<double>& v, double t, double force_scale);
+  /// ρ_m, the skeleton's inertia per volume and n_l of particle p (S_l from the thermal physics, else 1).
+  void densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
+  void map_to_grid();
+  void update_stress();
+  void predict();
+  void correct();
+  void map_to_particles();
+  void set_geostatic_stress();
+  [[noreturn]] void report_failure(std::size_t p) const;
+};
+
+}  // namespace frostmpm::mechanical
