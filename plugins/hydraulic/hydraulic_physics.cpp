@@ -28,6 +28,12 @@ ParamSchema HydraulicPhysics::schema() {
   s.integer("max_linear_iterations", "Krylov iterations per pressure solve before the run stops")
       .defaults_to(2000L)
       .at_least(1);
+  s.real("flip_fraction", "-",
+         "moving particles: the pressure each particle carries is updated by the grid's increment (FLIP, 1) "
+         "blended with the grid's value (PIC, 0) at every step")
+      .defaults_to(0.99)
+      .at_least(0)
+      .at_most(1);
   s.real("stabilization", "-",
          "τ of the polynomial pressure projection (Eqs. 66–67): adds τ/(2G) ∫(S−ΠS)ᵀ(S−ΠS) dV · Δp/Δt, G the "
          "material's shear_modulus; damps checkerboard pressure modes; 0 switches it off")
@@ -37,6 +43,7 @@ ParamSchema HydraulicPhysics::schema() {
 }
 
 HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
+  flip_fraction_ = p.real("flip_fraction");
   reference_gravity_ = p.real("reference_gravity");
 }
 
@@ -111,11 +118,6 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
                   &mobility_})
     v->assign(n, 0.0);
   for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
-  if (stabilized_) {
-    std::size_t cells = 1;
-    for (int d = 0; d < kDim; ++d) cells *= static_cast<std::size_t>(sim.grid().cells[d]);
-    cell_stabilization_.assign(cells, 0.0);
-  }
 }
 
 void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
@@ -181,9 +183,13 @@ std::vector<Stage> HydraulicPhysics::stages() {
           std::move(drag_stage),
           {"hydraulic.predict", Phase::PredictMomentum, {node_pressure_.read(), v, vs_star}, {predicted_.write()},
            [this] { predict(); }},
-          {"hydraulic.pressure", Phase::Pressure, {v_star, node_pressure_.read(), vs_star}, {dp},
+          {"hydraulic.pressure", Phase::Pressure,
+           {v_star, node_pressure_.read(), vs_star, node_solid_mobility_.optional_read(),
+            node_solid_group_.optional_read(), shear_modulus_.optional_read()},
+           {dp},
            [this] { solve_pressure(); }},
-          {"hydraulic.correct", Phase::CorrectMomentum, {v_star, node_increment_.read(), node_pressure_.read(), vs},
+          {"hydraulic.correct", Phase::CorrectMomentum,
+           {v_star, node_increment_.read(), node_pressure_.read(), vs, vs_star},
            {velocity_.write(), flux_.write(), p_node}, [this] { correct(); }},
           {"hydraulic.map_to_particles", Phase::MapToParticles, {node_pressure_.read(), node_increment_.read()},
            {pressure_.write()}, [this] { map_to_particles(); }}};
@@ -198,6 +204,13 @@ void HydraulicPhysics::initialize() {
   if (moving_) {
     const auto p = pressure_.values();
     carried_.assign(p.begin(), p.end());
+  }
+  // The projection's G: the skeleton model's (a mechanical physics), else the material's.
+  stabilized_ = stabilized_ || (shear_modulus_.bound() && params_.real("stabilization") > 0);
+  if (stabilized_) {
+    std::size_t cells = 1;
+    for (int d = 0; d < kDim; ++d) cells *= static_cast<std::size_t>(kernel_->grid().cells[d]);
+    cell_stabilization_.assign(cells, 0.0);
   }
   time_ = kernel_->time();
   update_coefficients();
@@ -235,14 +248,10 @@ void HydraulicPhysics::update_coefficients() {
     const double inertia = mass_scaling_ * (n_l_[p] * rho);
     xi_[p] = inertia > 0 ? inertia / (inertia + dt_ * drag_[p]) : 0.0;
     storage_[p] = n_l_[p] * m.compressibility;
-    if (coupled_) {
-      // The two-phase corrector of a skeleton of inertia m_s (models/two_phase.hpp).
-      const auto mobility = two_phase::corrector_mobility(skeleton_inertia_.values()[p], inertia, n_l_[p], drag_[p], dt_);
-      mobility_[p] = mobility.liquid;
-      eta_[p] = two_phase::poisson_coefficient(mobility, n_l_[p], m.zeta * phi[p] * (1.0 - std::clamp(S[p], 0.0, 1.0)));
-      return;
-    }
-    // Rigid skeleton: η = ξ n_l / ρ_l = n_l² / (n_l ρ_l + Δt C_d), written so that Δt → 0 stays finite.
+    // The liquid's own response n_l/(m_l + Δt C_d) (= ξ/ρ_l) and its Poisson coefficient
+    // η = n_l²/(m_l + Δt C_d), written so that Δt → 0 stays finite; a moving skeleton adds its
+    // own response in the matrix (assemble_skeleton).
+    mobility_[p] = inertia > 0 ? n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
     eta_[p] = inertia > 0 ? n_l_[p] * n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
   });
 }
@@ -379,23 +388,32 @@ void HydraulicPhysics::drag() {
   });
 }
 
-/// v = v* − Δt λ_l ∇Δp(x_p) at every particle (Eq. 47; rigid skeleton: λ_l = ξ/ρ_l); p_i += Δp_i;
-/// the Darcy flux q = n_l (v − v_s). The pressure solve made Σ_p V_p ∇S_ip · q_p balance storage,
-/// sources, the skeleton's volume change and boundary inflow (exactly, for a rigid skeleton).
+/// v = v* − Δt ξ/ρ_l ∇Δp(x_p) at every particle (Eq. 47); with a moving skeleton the liquid also
+/// follows the skeleton's correction through the drag: + (1 − ξ) Δv_s(x_p) (models/two_phase.hpp);
+/// p_i += Δp_i; the Darcy flux q = n_l (v − v_s). The pressure solve made Σ_p V_p ∇S_ip · q_p
+/// balance storage, sources, the skeleton's volume change and boundary inflow exactly.
 void HydraulicPhysics::correct() {
   const auto& st = kernel_->transfer().stencil();
   const auto v_star = predicted_.mutable_values();
   auto v = velocity_.mutable_values();
   auto flux = flux_.mutable_values();
   const auto vs = coupled_ ? node_solid_velocity_.values() : std::span<const double>{};
+  const auto vs_star = coupled_ ? node_solid_predicted_.values() : std::span<const double>{};
   parallel_for(kernel_->particle_count(), [&](std::size_t q) {
     const auto grad = nodal_gradient_at(st, q, *dp_);
-    const double a = coupled_ ? dt_ * mobility_[q]
-                              : dt_ * xi_[q] / (mass_scaling_ * materials_[material_[q]].water_density);
-    std::array<double, kDim> skeleton{};
-    if (coupled_) skeleton = kernel_->transfer().vector_at(q, vs);
+    if (!coupled_) {
+      const double a = dt_ * xi_[q] / (mass_scaling_ * materials_[material_[q]].water_density);
+      for (int d = 0; d < kDim; ++d) {
+        v[q * kDim + d] = v_star[q * kDim + d] - a * grad[d];
+        flux[q * kDim + d] = n_l_[q] * v[q * kDim + d];
+      }
+      return;
+    }
+    const auto skeleton = kernel_->transfer().vector_at(q, vs);
+    const auto predicted = kernel_->transfer().vector_at(q, vs_star);
     for (int d = 0; d < kDim; ++d) {
-      v[q * kDim + d] = v_star[q * kDim + d] - a * grad[d];
+      v[q * kDim + d] = v_star[q * kDim + d] + (1.0 - xi_[q]) * (skeleton[d] - predicted[d]) -
+                        dt_ * mobility_[q] * grad[d];
       flux[q * kDim + d] = n_l_[q] * (v[q * kDim + d] - skeleton[d]);
     }
   });
@@ -416,7 +434,9 @@ void HydraulicPhysics::map_to_particles() {
       const auto* w = st.weights(a);
       double change = 0;
       for (int k = 0; k < st.per_particle(); ++k) change += w[k] * ((*p_)[nodes[k]] - node_state_[nodes[k]]);
-      carried_[a] += change;
+      // A little of the grid's value each step damps what P2G cannot see and deformation then
+      // shows (particle-level noise, measured in a strip-loaded block); 1 is pure FLIP.
+      carried_[a] = flip_fraction_ * (carried_[a] + change) + (1.0 - flip_fraction_) * p[a];
     });
 }
 

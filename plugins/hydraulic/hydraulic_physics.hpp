@@ -106,12 +106,15 @@ class HydraulicPhysics final : public Physics {
   FieldHandle skeleton_inertia_ = FieldHandle::particle("skeleton_inertia");
   FieldHandle node_solid_predicted_ = FieldHandle::node("solid_velocity_predicted", kDim);
   FieldHandle node_solid_velocity_ = FieldHandle::node("solid_velocity", kDim);
+  FieldHandle node_solid_mobility_ = FieldHandle::node("solid_mobility", kDim);
+  FieldHandle node_solid_group_ = FieldHandle::node("solid_group");  ///< nodes moving as one body (rigid plates)
+  FieldHandle shear_modulus_ = FieldHandle::particle("shear_modulus");  ///< G of the skeleton's model, when it has one
   FieldHandle liquid_drag_ = FieldHandle::particle("liquid_drag");
   FieldHandle liquid_reaction_ = FieldHandle::particle("liquid_reaction", kDim, FieldKind::Vector);
   FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share");
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
-  double mass_scaling_ = 1;
+  double mass_scaling_ = 1, flip_fraction_ = 0.99;
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
@@ -121,7 +124,10 @@ class HydraulicPhysics final : public Physics {
   // ---- particles: per-step coefficients
   std::span<const std::uint16_t> material_;  ///< material index of every particle (the kernel's)
   std::vector<double> n_l_, drag_, xi_, eta_, storage_, k_a_, k_r_, scratch_;
-  std::vector<double> mobility_;  ///< coupled: λ_l, the liquid's velocity change per Δt ∇Δp
+  std::vector<double> mobility_;  ///< n_l / (m_l + Δt C_d): the liquid's own velocity change per Δt ∇Δp
+  // Coupled: Q, the mass balance's dependence on the skeleton's nodal velocity (Dim values per
+  // entry of the graph), and its transpose; the pressure matrix holds Δt Q M⁻¹ Qᵀ
+  std::vector<double> coupling_, coupling_transposed_;
   std::vector<double> carried_;     ///< moving particles: the pressure each carries (FLIP)
   std::vector<double> node_state_;  ///< moving particles: its projection at the step's start
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
@@ -146,6 +152,7 @@ class HydraulicPhysics final : public Physics {
 
   // ---- pressure system
   StencilGraph graph_;
+  StencilGraph compact_;  ///< coupled: the particle-stencil pattern of Q (graph_ is its square)
   std::unique_ptr<SparseSystem> system_;
   std::vector<double> values_;
   bool preconditioner_built_ = false;  ///< for the current system (a restart builds a new one)
@@ -184,6 +191,9 @@ class HydraulicPhysics final : public Physics {
   void correct();
   void map_to_particles();
   void assemble();
+  /// Coupled: adds Δt Q M⁻¹ Qᵀ, the skeleton's exact response to the pressure increment.
+  void assemble_skeleton();
+  std::vector<std::vector<std::size_t>> group_rows() const;
 };
 
 }  // namespace frostmpm::hydraulic

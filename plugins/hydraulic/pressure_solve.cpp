@@ -9,6 +9,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "frostmpm/parallel/parallel.hpp"
@@ -21,7 +23,10 @@ void HydraulicPhysics::assemble() {
   const auto vol = volume_.values();
   const std::size_t nodes = node_mass_.size();
   if (!system_ || graph_.topology_version != kernel_->transfer().topology_version()) {
-    graph_.build(st, nodes);
+    // A moving skeleton couples nodes two stencils apart (Q M⁻¹ Qᵀ), and every node near a
+    // rigid plate with every other (the plate moves as one body).
+    graph_.build(st, nodes, /*squared=*/coupled_, group_rows());
+    if (coupled_) compact_.build(st, nodes);
     graph_.topology_version = kernel_->transfer().topology_version();
     SolverOptions options;
     options.method = params_.string("solver");
@@ -75,6 +80,7 @@ void HydraulicPhysics::assemble() {
       }
     }
   });
+  if (coupled_) assemble_skeleton();
   if (stabilized_) add_stabilization();
   for (auto& bc : flux_bcs_) {
     const double q = bc.value(time_ + dt_);
@@ -131,6 +137,107 @@ void HydraulicPhysics::assemble() {
   }
 }
 
+/// The skeleton's part of the projection, exact for its lumped nodal correction. The mass balance
+/// depends on the skeleton's nodal velocity through Q_ij = Σ_p V_p [S_ip ∇S_jp + (n_l ξ)_p ∇S_ip S_jp]
+/// (its volume change, strong form, and the relative flux the drag leaves it); the mechanical
+/// physics corrects the skeleton by (m_j + Δt D_j) Δv_j = Δt Σ_i Q_ij Δp_i — the weak form of the
+/// mixture's pressure force plus the liquid's share — with its lumped mobility 1/(m_j + Δt D_j)
+/// (0 where a velocity condition holds a component). So the pressure equation gains
+/// Δt Q M⁻¹ Qᵀ: symmetric, and wider than the particle Laplacian (two stencils).
+void HydraulicPhysics::assemble_skeleton() {
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
+  const auto share = liquid_share_.values();
+  const auto mobility = node_solid_mobility_.values();
+  const int K = st.per_particle();
+  const std::size_t nodes = node_mass_.size();
+  // Q in the particle-stencil pattern (compact_), Dim values per entry.
+  coupling_.assign(compact_.nonzeros() * kDim, 0.0);
+  coupling_transposed_.assign(compact_.nonzeros() * kDim, 0.0);
+  kernel_->transfer().scatter([&](std::size_t q) {
+    const auto* w = st.weights(q);
+    const auto* g = st.gradients(q);
+    const int* slot = compact_.scatter.data() + q * K * K;
+    for (int a = 0; a < K; ++a)
+      for (int b = 0; b < K; ++b)
+        for (int d = 0; d < kDim; ++d)
+          coupling_[std::size_t(slot[a * K + b]) * kDim + d] +=
+              vol[q] * (w[a] * g[b * kDim + d] + share[q] * g[a * kDim + d] * w[b]);
+  });
+  // Qᵀ in the same (structurally symmetric) pattern: row j holds Q_kj at column k.
+  parallel_for(nodes, [&](std::size_t j) {
+    for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f) {
+      const auto k = static_cast<std::size_t>(compact_.columns[f]);
+      const std::size_t e = compact_.position(k, static_cast<int>(j));
+      for (int d = 0; d < kDim; ++d) coupling_transposed_[f * kDim + d] = coupling_[e * kDim + d];
+    }
+  });
+  // A_ik += Δt Σ_j Σ_d Q_ij,d M_jd⁻¹ Q_kj,d, row by row (each row its own: no race, any thread
+  // count), with the row's columns found through a per-thread map from node to CSR position.
+  // Nodes of a rigid plate move as one: their tied component is one column, Σ_j∈plate Q_ij,axis.
+  const auto group = node_solid_group_.bound() ? node_solid_group_.values() : std::span<const double>{};
+  auto tied = [&](std::size_t j, int d) { return !group.empty() && group[j] > 0 && int(group[j] - 1) % kDim == d; };
+#pragma omp parallel if (nodes >= kParallelMinimum)
+  {
+    std::vector<std::size_t> slot_of(nodes, 0);
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < nodes; ++i) {
+      for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) slot_of[std::size_t(graph_.columns[e])] = e;
+      for (std::size_t e = compact_.offsets[i]; e < compact_.offsets[i + 1]; ++e) {
+        const auto j = static_cast<std::size_t>(compact_.columns[e]);
+        double a[kDim];
+        bool any = false;
+        for (int d = 0; d < kDim; ++d) {
+          a[d] = tied(j, d) ? 0.0 : dt_ * coupling_[e * kDim + d] * mobility[j * kDim + d];
+          any = any || a[d] != 0;
+        }
+        if (!any) continue;
+        for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f) {
+          double sum = 0;
+          for (int d = 0; d < kDim; ++d) sum += a[d] * coupling_transposed_[f * kDim + d];
+          values_[slot_of[std::size_t(compact_.columns[f])]] += sum;
+        }
+      }
+    }
+  }
+  if (group.empty()) return;
+  // The plates: Q_g,i = Σ_{j ∈ g} Q_ij,axis over the rows that touch them; A += Δt Q_g Q_gᵀ / M_g.
+  std::map<int, std::map<std::size_t, double>> columns;  // group → row → Q_g,i
+  std::map<int, double> group_mobility;
+  for (std::size_t j = 0; j < nodes; ++j) {
+    if (!(group[j] > 0)) continue;
+    const int g = int(group[j]), d = (g - 1) % kDim;
+    group_mobility[g] = mobility[j * kDim + d];
+    for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f)
+      columns[g][std::size_t(compact_.columns[f])] += coupling_transposed_[f * kDim + d];  // Q_kj,d
+  }
+  for (const auto& [g, rows] : columns) {
+    const double factor = dt_ * group_mobility[g];
+    for (const auto& [i, qi] : rows)
+      for (const auto& [k, qk] : rows) values_[graph_.position(i, int(k))] += factor * qi * qk;
+  }
+}
+
+/// For each rigid plate, the rows its nodes' columns of Q reach (read from the node field the
+/// mechanical physics writes), for the graph.
+std::vector<std::vector<std::size_t>> HydraulicPhysics::group_rows() const {
+  std::vector<std::vector<std::size_t>> out;
+  if (!coupled_ || !node_solid_group_.bound()) return out;
+  const auto group = node_solid_group_.values();
+  const auto& st = kernel_->transfer().stencil();
+  std::map<int, std::set<std::size_t>> rows;
+  // A row i touches plate node j when some particle's stencil holds both.
+  const int K = st.per_particle();
+  for (std::size_t p = 0; p < st.particles(); ++p) {
+    const auto* n = st.nodes(p);
+    for (int a = 0; a < K; ++a)
+      if (group[n[a]] > 0)
+        for (int b = 0; b < K; ++b) rows[int(group[n[a]])].insert(n[b]);
+  }
+  for (auto& [_, r] : rows) out.emplace_back(r.begin(), r.end());
+  return out;
+}
+
 namespace {
 /// ∫ (S − ΠS)ᵀ(S − ΠS) dA of a bilinear cell of area A, in units of A / 144, nodes counter-
 /// clockwise: the consistent mass A/36 (4 2 1 2) minus the cell average (A/16 everywhere).
@@ -153,7 +260,8 @@ std::array<std::size_t, 4> cell_nodes(const UniformGrid<kDim>& grid, std::size_t
 /// H Δp/Δt has the units of the other terms (docs/architecture.md).
 void HydraulicPhysics::add_stabilization() {
   const auto& grid = kernel_->grid();
-  if (stabilization_version_ != kernel_->transfer().version()) update_cell_stabilization();
+  // G of a constitutive model changes with the ice: then every step.
+  if (stabilization_version_ != kernel_->transfer().version() || shear_modulus_.bound()) update_cell_stabilization();
   for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
     const double w = cell_stabilization_[c] / (144.0 * dt_);
     if (w == 0) continue;
@@ -169,8 +277,10 @@ void HydraulicPhysics::update_cell_stabilization() {
   const auto x = position_.values();
   const auto vol = volume_.values();
   std::fill(cell_stabilization_.begin(), cell_stabilization_.end(), 0.0);
+  const auto G = shear_modulus_.bound() ? shear_modulus_.values() : std::span<const double>{};
+  const double tau = params_.real("stabilization");
   for (std::size_t q = 0; q < vol.size(); ++q) {
-    const double weight = vol[q] * materials_[material_[q]].stabilization;
+    const double weight = vol[q] * (G.empty() ? materials_[material_[q]].stabilization : G[q] > 0 ? tau / (2.0 * G[q]) : 0.0);
     if (weight == 0) continue;
     std::size_t c = 0, stride = 1;
     for (int d = 0; d < kDim; ++d) {

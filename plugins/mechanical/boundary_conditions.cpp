@@ -4,6 +4,8 @@
 //   {type: velocity, nodes: ..., x: v(t), y: ...}   the components given follow time functions
 //   {type: traction, nodes: {face: ...}, normal: t(t), shear: t(t)}   or x: / y: components [Pa]
 //   {type: surcharge, nodes: {face: y_max, range: [a, b]}, value: q(t)}  a pressure pushing in
+//   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
+//                                                   the total force F [N, per m in 2-D] (Mandel)
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
 // ∂Ω_v) and record the force they exert on the material (reaction probes). A traction acting
 // on a component a velocity condition prescribes is refused: the two would fight.
@@ -19,6 +21,9 @@ namespace {
 
 constexpr double kMaxVelocity = 1e4;   // m/s
 constexpr double kMaxTraction = 1e10;  // Pa
+
+/// constraint_owner_ value of a node component that a rigid plate moves.
+constexpr int kPlateOwner = -2;
 
 const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
 
@@ -81,6 +86,24 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
                             std::string(Dim == 3 ? ", z" : "") + " (m/s, a constant, table or expression)");
     add_velocity(bc, std::move(value));
   }
+  for (auto* bc : kernel.boundary_conditions("rigid_plate")) {
+    on_nodes(bc);
+    if (bc->face_axis < 0) throw bc->node->error("rigid_plate acts on a grid face: use nodes: {face: ...}");
+    PlateCondition c;
+    c.bc = bc;
+    c.nodes = bc->nodes;
+    c.axis = bc->face_axis;
+    c.side = bc->face_side;
+    c.load = TimeFunction::read(bc->node->child("force"), 1e12, end);
+    for (std::size_t i : c.nodes) {
+      int& owner = constraint_owner_[i * Dim + c.axis];
+      if (owner >= 0)
+        throw bc->node->error("the " + bc->label() + " and the " + velocity_bcs_[std::size_t(owner)].bc->label() +
+                              " both prescribe the " + axis_name(c.axis) + " motion of some nodes");
+      owner = kPlateOwner;
+    }
+    plates_.push_back(std::move(c));
+  }
   auto add_traction = [&](BoundaryCondition* bc, std::array<TimeFunction, Dim> value) {
     const bool face = bc->face_axis >= 0;
     if (!face) throw bc->node->error(bc->type + " acts on a grid face: use nodes: {face: ..., range: [from, to]}");
@@ -92,8 +115,10 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     for (int d = 0; d < Dim; ++d) {
       if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
       for (std::size_t i : c.nodes)
-        if (constraint_owner_[i * Dim + d] >= 0) {
-          const auto* other = velocity_bcs_[std::size_t(constraint_owner_[i * Dim + d])].bc;
+        if (constraint_owner_[i * Dim + d] >= 0 || constraint_owner_[i * Dim + d] == kPlateOwner) {
+          const auto* other = constraint_owner_[i * Dim + d] == kPlateOwner
+                                  ? plates_.front().bc
+                                  : velocity_bcs_[std::size_t(constraint_owner_[i * Dim + d])].bc;
           throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component of nodes that the " +
                                 other->label() + " prescribes: a velocity condition and a traction cannot both act on "
                                 "one component");
@@ -157,7 +182,31 @@ void MechanicalPhysics<Dim>::constrain(std::vector<double>& v, double t, double 
 }
 
 template <int Dim>
+void MechanicalPhysics<Dim>::tie_plates(std::vector<double>& v, double t, double dt, bool with_drag) {
+  for (auto& c : plates_) {
+    double momentum = 0, inertia = 0;
+    for (std::size_t i : c.nodes) {
+      const double m = mass_[i] + (with_drag ? dt_ * drag_[i] : 0.0);
+      momentum += m * v[i * Dim + c.axis];
+      inertia += m;
+    }
+    // The load pushes into the material: against the face's outward normal.
+    const double load = -c.side * c.load(t);
+    if (dt > 0) {  // the predictor: the load of this step
+      c.applied = {};
+      c.applied[c.axis] = load;
+    }
+    if (inertia <= 0) continue;
+    const double plate = (momentum + dt * load) / inertia;
+    for (std::size_t i : c.nodes)
+      if (mass_[i] > 0) v[i * Dim + c.axis] = plate;
+  }
+}
+
+template <int Dim>
 std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const BoundaryCondition& bc) const {
+  for (const auto& c : plates_)
+    if (c.bc == &bc) return c.applied;
   for (const auto& c : velocity_bcs_)
     if (c.bc == &bc) return c.reaction;
   for (const auto& c : traction_bcs_)
@@ -170,6 +219,7 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
 #define FROSTMPM_MECHANICAL_BOUNDARIES(D)                                                          \
   template void MechanicalPhysics<D>::read_boundaries(Kernel<D>&);                                 \
   template void MechanicalPhysics<D>::constrain(std::vector<double>&, double, double);             \
+  template void MechanicalPhysics<D>::tie_plates(std::vector<double>&, double, double, bool);      \
   template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const;
 FROSTMPM_MECHANICAL_BOUNDARIES(2)
 FROSTMPM_MECHANICAL_BOUNDARIES(3)

@@ -60,6 +60,7 @@ MechanicalPhysics<Dim>::MechanicalPhysics(const ParamSet& p) : params_(p) {
   strain_ = FieldHandle::particle("strain", 6, FieldKind::SymmetricTensor);
   deformation_ = FieldHandle::particle("deformation_gradient", 9, FieldKind::Tensor);
   inertia_ = FieldHandle::particle("skeleton_inertia");
+  shear_ = FieldHandle::particle("shear_modulus");
   temperature_ = FieldHandle::particle("temperature");
   saturation_ = FieldHandle::particle("liquid_saturation");
   pore_pressure_ = FieldHandle::particle("pore_pressure");
@@ -70,6 +71,8 @@ MechanicalPhysics<Dim>::MechanicalPhysics(const ParamSet& p) : params_(p) {
   node_predicted_ = FieldHandle::node("solid_velocity_predicted", Dim);
   node_increment_ = FieldHandle::node("pressure_increment");
   node_pressure_ = FieldHandle::node("pore_pressure");
+  node_mobility_ = FieldHandle::node("solid_mobility", Dim);
+  node_group_ = FieldHandle::node("solid_group");
 }
 
 template <int Dim>
@@ -96,6 +99,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   kernel.declare_field("strain", 6, 0.0, FieldKind::SymmetricTensor);
   kernel.declare_field("deformation_gradient", 9, 0.0, FieldKind::Tensor);
   kernel.declare_field("skeleton_inertia", 1, 0.0);
+  kernel.declare_field("shear_modulus", 1, 0.0);
   kernel.fill_from_materials("porosity", "porosity");
 
   for (const auto& m : kernel.materials()) {
@@ -153,7 +157,8 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
                                        temperature_.optional_read(), saturation_.optional_read(),
                                        pore_pressure_.optional_read()};
   std::vector<FieldRef> start_writes = {node_velocity_.write(), stress_.write(),  strain_.write(),
-                                        deformation_.write(),   porosity_.write(), inertia_.write()};
+                                        deformation_.write(),   porosity_.write(), inertia_.write(),
+                                        shear_.write()};
   for (auto& h : variables_start_) start_reads.push_back(h.read());
   for (auto& h : variables_) start_writes.push_back(h.write());
   return {
@@ -162,7 +167,7 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
        Phase::PredictMomentum,
        {node_velocity_.read(), stress_.read(), node_pressure_.optional_read(), liquid_drag_.optional_read(),
         liquid_reaction_.optional_read(), volume_.read(), porosity_.read(), saturation_.optional_read()},
-       {node_predicted_.write()},
+       {node_predicted_.write(), node_mobility_.write(), node_group_.write()},
        [this] { predict(); }},
       {"mechanical.correct",
        Phase::CorrectMomentum,
@@ -237,6 +242,7 @@ void MechanicalPhysics<Dim>::initialize() {
       throw bc->node->error("the " + bc->label() + " touches no node the material reaches: it would do nothing");
   };
   for (const auto& c : velocity_bcs_) check(c.bc, c.nodes);
+  for (const auto& c : plates_) check(c.bc, c.nodes);
   for (const auto& c : traction_bcs_) check(c.bc, c.nodes);
 }
 
@@ -328,6 +334,7 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   parallel_for(mass_.size(), [&](std::size_t i) {
     for (int d = 0; d < Dim; ++d) vn[i * Dim + d] = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
   });
+  tie_plates(vn, time_, 0.0, false);
   constrain(vn, time_, 0.0);
   std::copy(vn.begin(), vn.end(), start_velocity_.begin());
   update_stress();
@@ -437,6 +444,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     out.state = state_out_;
     out.failed = {failed_.data() + r.begin, count};
     out.p_wave_modulus = {wave_modulus_.data() + r.begin, count};
+    out.shear_modulus = shear_.mutable_values().subspan(r.begin, count);
     m.model->integrate(in, out);
     for (std::size_t k = 0; k < nv; ++k) {
       auto values = variables_[m.variables[k]].mutable_values();
@@ -524,20 +532,50 @@ void MechanicalPhysics<Dim>::predict() {
   auto& v_star = node_predicted_.vector();
   parallel_for(mass_.size(), [&](std::size_t i) {
     const double m = mass_[i];
-    for (int d = 0; d < Dim; ++d) {
-      double f = force_[i * Dim + d];
-      const double v = vn[i * Dim + d];
-      // Cundall's local damping: a force against the motion, a fraction of the unbalanced force.
-      if (damping_ > 0 && v != 0) f -= damping_ * std::abs(f) * (v > 0 ? 1.0 : -1.0);
-      v_star[i * Dim + d] = m > 0 ? (m * v + dt_ * f) / (m + dt_ * drag_[i]) : 0.0;
-    }
+    for (int d = 0; d < Dim; ++d)
+      v_star[i * Dim + d] = m > 0 ? (m * vn[i * Dim + d] + dt_ * force_[i * Dim + d]) / (m + dt_ * drag_[i]) : 0.0;
   });
   for (auto& c : velocity_bcs_) c.reaction = {};
+  tie_plates(v_star, time_, dt_, true);
+  // Cundall's local damping: a force against the motion, a fraction α of the unbalanced force —
+  // the net force of the step (internal, body, traction, plate load and drag), m Δv*/Δt.
+  if (damping_ > 0)
+    parallel_for(mass_.size(), [&](std::size_t i) {
+      for (int d = 0; d < Dim; ++d) {
+        const double v = vn[i * Dim + d], change = v_star[i * Dim + d] - v;
+        if (v != 0) v_star[i * Dim + d] = v + change - damping_ * std::abs(change) * (v > 0 ? 1.0 : -1.0);
+      }
+    });
   constrain(v_star, time_ + dt_, 1.0);
+  // What a pressure increment can do to each nodal component, for the pore pressure's projection:
+  // 1/(m + Δt D), none where a velocity condition holds it; the nodes of a rigid plate move as
+  // one body (solid_group: 1 + plate·Dim + axis) of mobility 1/Σ(m + Δt D).
+  auto mobility = node_mobility_.mutable_values();
+  auto group = node_group_.mutable_values();
+  parallel_for(mass_.size(), [&](std::size_t i) {
+    const double m = mass_[i] + dt_ * drag_[i];
+    group[i] = 0;
+    for (int d = 0; d < Dim; ++d)
+      mobility[i * Dim + d] = m > 0 && constraint_owner_[i * Dim + d] == -1 ? 1.0 / m : 0.0;
+  });
+  for (std::size_t k = 0; k < plates_.size(); ++k) {
+    const auto& c = plates_[k];
+    double inertia = 0;
+    for (std::size_t i : c.nodes) inertia += mass_[i] > 0 ? mass_[i] + dt_ * drag_[i] : 0.0;
+    for (std::size_t i : c.nodes) {
+      if (mass_[i] <= 0) continue;
+      mobility[i * Dim + c.axis] = inertia > 0 ? 1.0 / inertia : 0.0;
+      group[i] = double(1 + k * Dim + std::size_t(c.axis));
+    }
+  }
 }
 
-/// The skeleton's share of the pressure correction (paper Eqs. 45–47 with the corrected ξ_s):
-/// Δv_i = −Δt Σ_p V_p S_ip (1 − n_l ξ)_p ∇Δp(x_p) / (m_i + Δt D_i).
+/// The skeleton's part of the pressure correction (paper Eqs. 44–47, the implicit drag as in the
+/// predictor, models/two_phase.hpp): the mixture's pressure force in the weak form of the total
+/// stress, ∫ Δp ∇S_j, as the predictor applies p^k — so that an undrained surface carries its
+/// load — plus what the liquid hands on through the drag, ∫ n_l ξ S_j ∇Δp:
+///   (m_j + Δt D_j) Δv_j = Δt Σ_p V_p [Δp(x_p) ∇S_jp + (n_l ξ)_p S_jp ∇Δp(x_p)].
+/// Where ∇Δp is smooth and the boundary drained this is −(1 − n_l ξ) ∇Δp, the corrected ξ_s.
 template <int Dim>
 void MechanicalPhysics<Dim>::correct() {
   auto& v = node_velocity_.vector();
@@ -554,17 +592,21 @@ void MechanicalPhysics<Dim>::correct() {
   const int K = st.per_particle();
   std::fill(force_.begin(), force_.end(), 0.0);
   transfer.scatter([&](std::size_t p) {
+    const double value = transfer.value_at(p, dp);
     const auto grad = transfer.gradient_at(p, dp);
-    const double a = vol[p] * (share.empty() ? 1.0 : 1.0 - share[p]);
+    const double liquid = share.empty() ? 0.0 : share[p];
     const auto* nodes = st.nodes(p);
     const auto* w = st.weights(p);
+    const auto* g = st.gradients(p);
     for (int b = 0; b < K; ++b)
-      for (int d = 0; d < Dim; ++d) force_[nodes[b] * Dim + d] -= w[b] * a * grad[d];
+      for (int d = 0; d < Dim; ++d)
+        force_[nodes[b] * Dim + d] += vol[p] * (value * g[b * Dim + d] + liquid * w[b] * grad[d]);
   });
   parallel_for(mass_.size(), [&](std::size_t i) {
     const double m = mass_[i] + dt_ * drag_[i];
     for (int d = 0; d < Dim; ++d) v[i * Dim + d] = v_star[i * Dim + d] + (m > 0 ? dt_ * force_[i * Dim + d] / m : 0.0);
   });
+  tie_plates(v, time_, 0.0, true);
   constrain(v, time_ + dt_, 1.0);
 }
 

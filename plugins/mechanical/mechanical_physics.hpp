@@ -43,7 +43,7 @@ class MechanicalPhysics final : public Physics {
     return {{"mechanical_model", MechanicalModel::kKind, true}};
   }
   std::vector<std::string> boundary_types() const override {
-    return {"fixed", "roller", "velocity", "traction", "surcharge"};
+    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate"};
   }
 
   void setup(Kernel<Dim>& kernel) override;
@@ -72,6 +72,15 @@ class MechanicalPhysics final : public Physics {
     std::array<TimeFunction, Dim> value;  ///< traction vector components [Pa]
     std::array<double, 3> applied{};      ///< force it applied over the last step
   };
+  /// A rigid, frictionless plate on a face: the normal velocity of all its nodes is one, driven
+  /// by the total force on it (the load it carries and the material's reaction).
+  struct PlateCondition {
+    const BoundaryCondition* bc = nullptr;
+    std::vector<std::size_t> nodes;
+    int axis = 0, side = 1;
+    TimeFunction load;                 ///< total force pushing into the material [N (per m in 2-D)]
+    std::array<double, 3> applied{};   ///< the load over the last step, as a force on the material
+  };
   struct MaterialData {
     std::shared_ptr<MechanicalModel> model;
     std::string model_name;
@@ -87,12 +96,13 @@ class MechanicalPhysics final : public Physics {
   std::vector<MaterialData> materials_;
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;
+  std::vector<PlateCondition> plates_;
   std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition, or −1
 
   // ---- fields (bound by the kernel once the step is resolved)
   FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,
-      inertia_, temperature_, saturation_, pore_pressure_, liquid_drag_, liquid_reaction_, liquid_share_;
-  FieldHandle node_velocity_, node_predicted_, node_increment_, node_pressure_;
+      inertia_, shear_, temperature_, saturation_, pore_pressure_, liquid_drag_, liquid_reaction_, liquid_share_;
+  FieldHandle node_velocity_, node_predicted_, node_increment_, node_pressure_, node_mobility_, node_group_;
   std::vector<std::string> variable_names_;                 ///< internal variables of every model, once each
   std::vector<FieldHandle> variables_, variables_start_;    ///< their particle fields
 
@@ -113,6 +123,9 @@ class MechanicalPhysics final : public Physics {
   /// Sets the prescribed components of the nodal velocity `v` at time t; with `force_scale` > 0
   /// adds each condition's reaction (force_scale · (v_prescribed − v_free) per component).
   void constrain(std::vector<double>& v, double t, double force_scale);
+  /// Gives every plate's nodes one normal velocity, momentum-weighted with the nodal inertia
+  /// m (+ Δt D when `with_drag`), plus `dt` times the plate's load at time t.
+  void tie_plates(std::vector<double>& v, double t, double dt, bool with_drag);
   /// ρ_m, the skeleton's inertia per volume and n_l of particle p (S_l from the thermal physics, else 1).
   void densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
   void map_to_grid();

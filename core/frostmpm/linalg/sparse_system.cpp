@@ -307,11 +307,21 @@ struct SparseSystem::Impl {
       // A refresh keeps the aggregates and prolongators and recomputes the coarse operators and
       // smoothers from the new values (MueLu's "RP" reuse).
       params.set("reuse: type", "RP");
+      bool refreshed = false;
       if (!muelu.is_null() && refresh) {
-        MueLu::ReuseTpetraPreconditioner(preconditioner_matrix, *muelu);
-      } else {
-        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
+        // The reuse keeps the coarse operators' graphs, which MueLu built from the nonzero
+        // values: an entry that was zero then (a row fixed as a boundary or a dry node, which
+        // may become free when particles move or ice melts) does not fit, and MueLu throws.
+        // Then the preconditioner is built anew.
+        try {
+          MueLu::ReuseTpetraPreconditioner(preconditioner_matrix, *muelu);
+          refreshed = true;
+        } catch (const std::exception&) {
+          refreshed = false;
+        }
       }
+      if (!refreshed)
+        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
       problem->setRightPrec(muelu);
     }
     have_preconditioner = true;

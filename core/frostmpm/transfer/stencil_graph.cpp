@@ -13,7 +13,8 @@ std::size_t StencilGraph::position(std::size_t row, int col) const {
 }
 
 template <int Dim>
-void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes) {
+void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes, bool squared,
+                         const std::vector<std::vector<std::size_t>>& cliques) {
   const int K = st.per_particle();
   std::vector<std::vector<int>> rows(nodes);
   for (std::size_t i = 0; i < nodes; ++i) rows[i].push_back(static_cast<int>(i));
@@ -22,13 +23,31 @@ void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes) {
     for (int a = 0; a < K; ++a)
       for (int b = 0; b < K; ++b) rows[n[a]].push_back(static_cast<int>(n[b]));
   }
+  for (auto& c : rows) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  }
+  if (squared) {
+    std::vector<std::vector<int>> wide(nodes);
+    parallel_for(nodes, [&](std::size_t i) {
+      for (const int j : rows[i]) wide[i].insert(wide[i].end(), rows[std::size_t(j)].begin(), rows[std::size_t(j)].end());
+      std::sort(wide[i].begin(), wide[i].end());
+      wide[i].erase(std::unique(wide[i].begin(), wide[i].end()), wide[i].end());
+    });
+    rows = std::move(wide);
+  }
+  for (const auto& clique : cliques) {
+    for (std::size_t i : clique) {
+      auto& c = rows[i];
+      for (std::size_t k : clique) c.push_back(static_cast<int>(k));
+      std::sort(c.begin(), c.end());
+      c.erase(std::unique(c.begin(), c.end()), c.end());
+    }
+  }
   offsets.assign(nodes + 1, 0);
   columns.clear();
   for (std::size_t i = 0; i < nodes; ++i) {
-    auto& c = rows[i];
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-    columns.insert(columns.end(), c.begin(), c.end());
+    columns.insert(columns.end(), rows[i].begin(), rows[i].end());
     offsets[i + 1] = columns.size();
   }
   scatter.resize(st.particles() * K * K);
@@ -41,7 +60,9 @@ void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes) {
   for (std::size_t i = 0; i < nodes; ++i) diagonal[i] = position(i, static_cast<int>(i));
 }
 
-template void StencilGraph::build<2>(const StencilCache<2>&, std::size_t);
-template void StencilGraph::build<3>(const StencilCache<3>&, std::size_t);
+template void StencilGraph::build<2>(const StencilCache<2>&, std::size_t, bool,
+                                     const std::vector<std::vector<std::size_t>>&);
+template void StencilGraph::build<3>(const StencilCache<3>&, std::size_t, bool,
+                                     const std::vector<std::vector<std::size_t>>&);
 
 }  // namespace frostmpm

@@ -20,9 +20,14 @@ struct StencilGraph {
   /// The transfer topology it was built for (Transfer::topology_version(); the caller sets it).
   std::uint64_t topology_version = ~std::uint64_t{0};
 
-  /// Builds the graph of `nodes` nodes from the stencil's particles.
+  /// Builds the graph of `nodes` nodes from the stencil's particles. `squared`: the pattern of
+  /// a product of two such operators (node i couples to k when some node j couples to both,
+  /// e.g. Q M⁻¹ Qᵀ of a divergence Q and a lumped mass M), which holds the plain one.
+  /// `cliques`: sets of nodes that all couple with one another besides (bodies whose nodes move
+  /// as one, e.g. a rigid plate).
   template <int Dim>
-  void build(const StencilCache<Dim>& stencil, std::size_t nodes);
+  void build(const StencilCache<Dim>& stencil, std::size_t nodes, bool squared = false,
+             const std::vector<std::vector<std::size_t>>& cliques = {});
   std::size_t rows() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   std::size_t nonzeros() const { return columns.size(); }
   /// CSR position of (row, col), which must be in the pattern.
