@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
 
   app::TestModelOptions test_model_options;
   auto* test_model = cli.add_subcommand(
-      "test-model", "check a model's contract by sampling it (bounds, monotonicity, derivatives, continuity); "
+      "test-model", "check a model's contract by sampling it (bounds, monotonicity, derivatives, continuity, objectivity); "
                     "exit 1 with one line per violation");
   test_model->add_option("target", test_model_options.target, "KIND/NAME, e.g. sfcc/exponential")->required();
   test_model->add_option("--set", test_model_options.settings,
@@ -273,7 +273,7 @@ int main(int argc, char** argv) {
   test_model->add_option("--temperature-range", test_model_options.temperature_range,
                          "SFCC: sampled temperatures LO HI in degC (default: freezing point -10 to +2)")
       ->expected(2);
-  test_model->add_option("--samples", test_model_options.samples, "sample points (default 2001)")
+  test_model->add_option("--samples", test_model_options.samples, "sample points, or states of a mechanical model (default 2001)")
       ->check(CLI::Range(2, 10000000));
 
   try {

@@ -28,12 +28,6 @@ ParamSchema HydraulicPhysics::schema() {
   s.integer("max_linear_iterations", "Krylov iterations per pressure solve before the run stops")
       .defaults_to(2000L)
       .at_least(1);
-  s.real("flip_fraction", "-",
-         "moving particles: the pressure each particle carries is updated by the grid's increment (FLIP, 1) "
-         "blended with the grid's value (PIC, 0) at every step")
-      .defaults_to(0.99)
-      .at_least(0)
-      .at_most(1);
   s.real("stabilization", "-",
          "τ of the polynomial pressure projection (Eqs. 66–67): adds τ/(2G) ∫(S−ΠS)ᵀ(S−ΠS) dV · Δp/Δt, G the "
          "material's shear_modulus; damps checkerboard pressure modes; 0 switches it off")
@@ -43,7 +37,6 @@ ParamSchema HydraulicPhysics::schema() {
 }
 
 HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
-  flip_fraction_ = p.real("flip_fraction");
   reference_gravity_ = p.real("reference_gravity");
 }
 
@@ -178,7 +171,8 @@ std::vector<Stage> HydraulicPhysics::stages() {
   Stage drag_stage{"hydraulic.drag", Phase::PredictMomentum, {node_pressure_.read(), v, m_s},
                    {liquid_drag_.write(), liquid_reaction_.write(), liquid_share_.write()}, [this] { drag(); }};
   drag_stage.skippable = true;  // only a skeleton that moves reads what it writes
-  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T, m_s}, {p_node},
+  return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T, m_s, node_solid_start_.optional_read()},
+           {p_node},
            [this] { map_to_grid(); }},
           std::move(drag_stage),
           {"hydraulic.predict", Phase::PredictMomentum, {node_pressure_.read(), v, vs_star}, {predicted_.write()},
@@ -201,10 +195,7 @@ void HydraulicPhysics::initialize() {
   temperature_ = temperature_field_.bound();
   coupled_ = skeleton_inertia_.bound();
   moving_ = kernel_->particles_move();
-  if (moving_) {
-    const auto p = pressure_.values();
-    carried_.assign(p.begin(), p.end());
-  }
+  if (moving_) was_active_.assign(kernel_->grid().node_count(), 0);
   // The projection's G: the skeleton model's (a mechanical physics), else the material's.
   stabilized_ = stabilized_ || (shear_modulus_.bound() && params_.real("stabilization") > 0);
   if (stabilized_) {
@@ -257,29 +248,79 @@ void HydraulicPhysics::update_coefficients() {
 }
 
 /// P2G of the particles' pressure (volume-weighted): the nodal state at the start, and
-/// whenever particles have moved. Moving particles carry the state (carried_, updated by FLIP
-/// increments): its projection is kept as node_state_, and the pressure field the step works
-/// with has the boundary values on top. Standing particles: the grid is the state.
+/// whenever standing particles were moved by something else (a restart). The grid holds the
+/// state from then on.
 void HydraulicPhysics::project_to_grid() {
   const auto& st = kernel_->transfer().stencil();
+  project_particles(*p_);
+  set_boundary_pressures(time_);
+  projected_version_ = st.version();
+  grid_valid_ = true;
+}
+
+/// The particles' pressure projected onto the nodes (volume-weighted), into `into`.
+void HydraulicPhysics::project_particles(std::vector<double>& into) const {
+  const auto& st = kernel_->transfer().stencil();
   const auto vol = volume_.values();
-  const auto p = moving_ ? std::span<const double>(carried_) : pressure_.values();
-  std::vector<double> weight(p_->size(), 0.0);
-  std::fill(p_->begin(), p_->end(), 0.0);
+  const auto p = pressure_.values();
+  std::vector<double> weight(into.size(), 0.0);
+  std::fill(into.begin(), into.end(), 0.0);
   const int K = st.per_particle();
   kernel_->transfer().scatter([&](std::size_t q) {
     const auto* nodes = st.nodes(q);
     const auto* w = st.weights(q);
     for (int k = 0; k < K; ++k) {
       weight[nodes[k]] += w[k] * vol[q];
-      (*p_)[nodes[k]] += w[k] * vol[q] * p[q];
+      into[nodes[k]] += w[k] * vol[q] * p[q];
     }
   });
-  parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] = weight[i] > 0 ? (*p_)[i] / weight[i] : 0.0; });
-  if (moving_) node_state_ = *p_;
-  set_boundary_pressures(time_);
-  projected_version_ = st.version();
-  grid_valid_ = true;
+  parallel_for(into.size(), [&](std::size_t i) { into[i] = weight[i] > 0 ? into[i] / weight[i] : 0.0; });
+}
+
+/// Moving particles: the grid keeps the pressure, and the material carries it across the fixed
+/// nodes: p_i ← p_i − Δt v_s·∇p at every node the material covered last step (first-order
+/// upwind on the lattice, with the skeleton's nodal velocity of the step's start); a node the
+/// material newly reaches takes the particles' value. A P2G of the particles every step would
+/// smooth the state once per step (the mechanics' steps are small: a large numerical diffusion),
+/// and particles that carry it (FLIP) gather noise that deformation shows (measured in a
+/// strip-loaded block).
+void HydraulicPhysics::advect_grid_pressure() {
+  const auto& grid = kernel_->grid();
+  const std::size_t nodes = grid.node_count();
+  std::vector<double> fresh;  // the particles' value, for nodes the material newly covers
+  std::vector<char> active(nodes, 0);
+  for (std::size_t i = 0; i < nodes; ++i) active[i] = node_mass_[i] > 0;
+  bool any_new = false;
+  for (std::size_t i = 0; i < nodes && !any_new; ++i) any_new = active[i] && was_active_[i] == 0;
+  if (any_new) {
+    fresh.assign(nodes, 0.0);
+    project_particles(fresh);
+  }
+  const auto v = node_solid_start_.bound() ? node_solid_start_.values() : std::span<const double>{};
+  std::vector<double> next(*p_);
+  parallel_for(nodes, [&](std::size_t i) {
+    if (!active[i]) return;
+    if (was_active_[i] == 0) {
+      next[i] = fresh[i];
+      return;
+    }
+    if (v.empty()) return;
+    const auto ijk = grid.node_lattice(i);
+    double change = 0;
+    for (int d = 0; d < kDim; ++d) {
+      const double u = v[i * kDim + d];
+      if (u == 0) continue;
+      auto neighbour = ijk;
+      neighbour[d] += u > 0 ? -1 : 1;  // upwind: where the material comes from
+      if (neighbour[d] < -grid.ghost_layers || neighbour[d] > grid.cells[d] + grid.ghost_layers) continue;
+      const std::size_t j = grid.node_index(neighbour);
+      if (was_active_[j] == 0) continue;
+      change -= dt_ * std::abs(u) * ((*p_)[i] - (*p_)[j]) / grid.spacing[d];
+    }
+    next[i] = (*p_)[i] + change;
+  });
+  *p_ = std::move(next);
+  for (std::size_t i = 0; i < nodes; ++i) was_active_[i] = active[i];
 }
 
 /// source_p = [ζ φ ΔS_l − β_m ΔT] / Δt over the step that just ended (Eq. 48's
@@ -313,7 +354,7 @@ void HydraulicPhysics::map_to_grid() {
   update_coefficients();
   update_source();
   const auto& st = kernel_->transfer().stencil();
-  if (!grid_valid_ || st.version() != projected_version_) project_to_grid();
+  if (!grid_valid_ || (!moving_ && st.version() != projected_version_)) project_to_grid();
   // The liquid mass marks the nodes the pressure lives on: a node whose pores hold less than
   // kWetFraction liquid (none, or ice all but completely) has no unknown — its row would be
   // scaled like n_l² (1e-300 where an SFCC underflows) and break the Krylov solver. Other
@@ -337,6 +378,7 @@ void HydraulicPhysics::map_to_grid() {
   parallel_for(node_mass_.size(), [&](std::size_t i) {
     if (node_mass_[i] <= kWetFraction * pore_mass[i]) node_mass_[i] = 0.0;
   });
+  if (moving_) advect_grid_pressure();
   // Boundary pressures at the step's start (a time function moves them between steps).
   set_boundary_pressures(time_);
 }
@@ -426,18 +468,6 @@ void HydraulicPhysics::map_to_particles() {
   const auto& st = kernel_->transfer().stencil();
   auto p = pressure_.mutable_values();
   parallel_for(p.size(), [&](std::size_t a) { p[a] = nodal_value_at(st, a, *p_); });
-  // Moving particles carry the state: its change since the projection (FLIP, Algorithm 1
-  // step 20), boundary values included; the field the particles show is the grid's.
-  if (moving_)
-    parallel_for(p.size(), [&](std::size_t a) {
-      const auto* nodes = st.nodes(a);
-      const auto* w = st.weights(a);
-      double change = 0;
-      for (int k = 0; k < st.per_particle(); ++k) change += w[k] * ((*p_)[nodes[k]] - node_state_[nodes[k]]);
-      // A little of the grid's value each step damps what P2G cannot see and deformation then
-      // shows (particle-level noise, measured in a strip-loaded block); 1 is pure FLIP.
-      carried_[a] = flip_fraction_ * (carried_[a] + change) + (1.0 - flip_fraction_) * p[a];
-    });
 }
 
 // ---- checkpoints and counters ----------------------------------------------------------------------
@@ -448,7 +478,7 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0});
   return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
           {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
-          {"carried_pressure", &carried_},
+          {"nodes_with_material", &was_active_},
           {"temperature_at_step_start", &T_prev_}};
 }
 

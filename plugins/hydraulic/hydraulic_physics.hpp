@@ -106,6 +106,8 @@ class HydraulicPhysics final : public Physics {
   FieldHandle skeleton_inertia_ = FieldHandle::particle("skeleton_inertia");
   FieldHandle node_solid_predicted_ = FieldHandle::node("solid_velocity_predicted", kDim);
   FieldHandle node_solid_velocity_ = FieldHandle::node("solid_velocity", kDim);
+  /// The same node field as read in map_to_grid: the skeleton's velocity at the step's start.
+  FieldHandle node_solid_start_ = FieldHandle::node("solid_velocity", kDim);
   FieldHandle node_solid_mobility_ = FieldHandle::node("solid_mobility", kDim);
   FieldHandle node_solid_group_ = FieldHandle::node("solid_group");  ///< nodes moving as one body (rigid plates)
   FieldHandle shear_modulus_ = FieldHandle::particle("shear_modulus");  ///< G of the skeleton's model, when it has one
@@ -114,7 +116,7 @@ class HydraulicPhysics final : public Physics {
   FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share");
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
-  double mass_scaling_ = 1, flip_fraction_ = 0.99;
+  double mass_scaling_ = 1;
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
@@ -128,8 +130,7 @@ class HydraulicPhysics final : public Physics {
   // Coupled: Q, the mass balance's dependence on the skeleton's nodal velocity (Dim values per
   // entry of the graph), and its transpose; the pressure matrix holds Δt Q M⁻¹ Qᵀ
   std::vector<double> coupling_, coupling_transposed_;
-  std::vector<double> carried_;     ///< moving particles: the pressure each carries (FLIP)
-  std::vector<double> node_state_;  ///< moving particles: its projection at the step's start
+  std::vector<double> was_active_;  ///< moving particles: nodes the material covered last step (1/0)
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
   std::vector<double> source_, S_prev_, T_prev_;
@@ -183,6 +184,8 @@ class HydraulicPhysics final : public Physics {
   /// on the nodes whose pressure is prescribed, plus the prescribed fluxes.
   void account_boundary_inflow();
   void project_to_grid();
+  void project_particles(std::vector<double>& into) const;
+  void advect_grid_pressure();
   void map_to_grid();
   void predict();
   /// Coupled: the drag stiffness C_d ξ, the reaction k ṽ − f_l and the share n_l ξ the skeleton needs.

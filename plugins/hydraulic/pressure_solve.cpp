@@ -22,11 +22,26 @@ void HydraulicPhysics::assemble() {
   const auto& st = kernel_->transfer().stencil();
   const auto vol = volume_.values();
   const std::size_t nodes = node_mass_.size();
+  if (coupled_ && system_ && graph_.topology_version != kernel_->transfer().topology_version()) {
+    // Particles moved into other stencils: the lattice patterns stay, only their map from
+    // particle pairs to entries changes.
+    graph_.build_scatter(st);
+    compact_.build_scatter(st);
+    graph_.topology_version = kernel_->transfer().topology_version();
+  }
   if (!system_ || graph_.topology_version != kernel_->transfer().topology_version()) {
-    // A moving skeleton couples nodes two stencils apart (Q M⁻¹ Qᵀ), and every node near a
-    // rigid plate with every other (the plate moves as one body).
-    graph_.build(st, nodes, /*squared=*/coupled_, group_rows());
-    if (coupled_) compact_.build(st, nodes);
+    if (coupled_) {
+      // A moving skeleton: fixed lattice patterns for the whole run. The matrix couples nodes two
+      // stencils apart (Q M⁻¹ Qᵀ), and every node near a rigid plate with every other (the plate
+      // moves as one body); Q itself one stencil apart.
+      const int reach = support_width(st.kind()) - 1;
+      graph_.build_lattice(kernel_->grid(), 2 * reach, group_rows());
+      graph_.build_scatter(st);
+      compact_.build_lattice(kernel_->grid(), reach);
+      compact_.build_scatter(st);
+    } else {
+      graph_.build(st, nodes);
+    }
     graph_.topology_version = kernel_->transfer().topology_version();
     SolverOptions options;
     options.method = params_.string("solver");
@@ -127,7 +142,7 @@ void HydraulicPhysics::assemble() {
     for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) {
       const auto j = static_cast<std::size_t>(graph_.columns[e]);
       if (j == i) continue;
-      const std::size_t ji = graph_.position(j, static_cast<int>(i));
+      const std::size_t ji = graph_.transpose[e];
       if (!fixed[j]) rhs_[j] -= values_[ji] * dp[i];
       values_[ji] = 0.0;
       values_[e] = 0.0;
@@ -167,8 +182,7 @@ void HydraulicPhysics::assemble_skeleton() {
   // Qᵀ in the same (structurally symmetric) pattern: row j holds Q_kj at column k.
   parallel_for(nodes, [&](std::size_t j) {
     for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f) {
-      const auto k = static_cast<std::size_t>(compact_.columns[f]);
-      const std::size_t e = compact_.position(k, static_cast<int>(j));
+      const std::size_t e = compact_.transpose[f];
       for (int d = 0; d < kDim; ++d) coupling_transposed_[f * kDim + d] = coupling_[e * kDim + d];
     }
   });
@@ -224,15 +238,22 @@ std::vector<std::vector<std::size_t>> HydraulicPhysics::group_rows() const {
   std::vector<std::vector<std::size_t>> out;
   if (!coupled_ || !node_solid_group_.bound()) return out;
   const auto group = node_solid_group_.values();
-  const auto& st = kernel_->transfer().stencil();
+  const auto& grid = kernel_->grid();
+  const int reach = support_width(kernel_->transfer().stencil().kind()) - 1;
+  // A row i touches plate node j when some particle's stencil could hold both: within `reach`
+  // lattice steps along each axis.
   std::map<int, std::set<std::size_t>> rows;
-  // A row i touches plate node j when some particle's stencil holds both.
-  const int K = st.per_particle();
-  for (std::size_t p = 0; p < st.particles(); ++p) {
-    const auto* n = st.nodes(p);
-    for (int a = 0; a < K; ++a)
-      if (group[n[a]] > 0)
-        for (int b = 0; b < K; ++b) rows[int(group[n[a]])].insert(n[b]);
+  for (std::size_t j = 0; j < group.size(); ++j) {
+    if (!(group[j] > 0)) continue;
+    const auto ijk = grid.node_lattice(j);
+    std::array<int, kDim> at{};
+    for (at[1] = ijk[1] - reach; at[1] <= ijk[1] + reach; ++at[1])
+      for (at[0] = ijk[0] - reach; at[0] <= ijk[0] + reach; ++at[0]) {
+        bool inside = true;
+        for (int d = 0; d < kDim; ++d)
+          inside = inside && at[d] >= -grid.ghost_layers && at[d] <= grid.cells[d] + grid.ghost_layers;
+        if (inside) rows[int(group[j])].insert(grid.node_index(at));
+      }
   }
   for (auto& [_, r] : rows) out.emplace_back(r.begin(), r.end());
   return out;

@@ -15,8 +15,8 @@
 //                     v* = (m v + Δt f)/(m + Δt D); velocity conditions on v* (their reaction kept);
 //   correct           with a pressure increment: Δv = −Δt Σ S V (1 − n_l ξ) ∇Δp / (m + Δt D)
 //                     (the skeleton's share of the two-phase corrector, models/two_phase.hpp);
-//   map_to_particles  FLIP/PIC blend of the velocity; x += Δt Σ S (v_i^k + ½ Δv_i) (Alg. 1 step 21,
-//                     the particle's v^k taken from the grid).
+//   map_to_particles  FLIP/PIC blend of the velocity; x += Δt Σ S v_i^k (symplectic with the stress
+//                     update; Alg. 1 step 21's trapezoid as an option, see map_to_particles).
 // The kernel derives particle volumes V = V0 det F and GIMP domains from the deformation
 // gradient and recomputes the stencils every step, since this physics writes `position`.
 #include <array>
@@ -92,7 +92,7 @@ class MechanicalPhysics final : public Physics {
   ParamSet params_;
   Kernel<Dim>* kernel_ = nullptr;
   double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
-  bool jaumann_ = true, geostatic_ = false;
+  bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
   std::vector<MaterialData> materials_;
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;

@@ -105,10 +105,11 @@ TEST_CASE("swapping only the model name names the old model's parameters and the
   CHECK(r.exit_code == 0);
 }
 
-TEST_CASE("test-model: every shipped SFCC and permeability model keeps its contract", "[plugins][contract]") {
+TEST_CASE("test-model: every shipped SFCC, permeability and mechanical model keeps its contract",
+          "[plugins][contract]") {
   const auto& registry = builtin_registry();
   int checked = 0;
-  for (const std::string kind : {"sfcc", "relative_permeability", "absolute_permeability"})
+  for (const std::string kind : {"sfcc", "relative_permeability", "absolute_permeability", "mechanical_model"})
     for (const auto* entry : registry.entries(kind)) {
       // Required parameters are picked inside their ranges; linear's mushy_end has no range.
       const std::string extra = entry->name == "linear" ? " --set mushy_end=-1" : "";
@@ -118,7 +119,24 @@ TEST_CASE("test-model: every shipped SFCC and permeability model keeps its contr
       CHECK(has(r.output, kind + "/" + entry->name + ": contract kept"));
       ++checked;
     }
-  CHECK(checked >= 9);
+  CHECK(checked >= 10);
+}
+
+TEST_CASE("test-model mechanical_model/linear_elastic samples its parameter ranges", "[plugins][contract]") {
+  auto r = run_frostmpm("test-model mechanical_model/linear_elastic");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK(has(r.output, "youngs_modulus=5e+12 (picked), poisson_ratio=-0.25 (picked), frozen_youngs_modulus=0"));
+  CHECK(has(r.output, "parameter sets: 7 (the above, and each of youngs_modulus, poisson_ratio, frozen_youngs_modulus "
+                      "at 1 % and 99 % of its range)"));
+  CHECK(has(r.output, "mechanical_model/linear_elastic: contract kept"));
+  // A parameter given with --set stays fixed.
+  r = run_frostmpm("test-model mechanical_model/linear_elastic --set youngs_modulus=1e6 --set poisson_ratio=0.3 "
+                   "--samples 100");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK(has(r.output, "parameter sets: 3 (the above, and each of frozen_youngs_modulus at 1 % and 99 % of its range)"));
+  CHECK(has(r.output, "sampled: 100 states per set"));
 }
 
 TEST_CASE("test-model flags a deliberately broken model, one line per violated rule, exit 1", "[plugins][contract]") {
@@ -137,7 +155,23 @@ TEST_CASE("test-model flags a deliberately broken model, one line per violated r
   r = run_frostmpm("test-model absolute_permeability/broken_absolute" + plugin);
   CHECK(r.exit_code == 1);
   CHECK(has(r.output, "violation: k_a(porosity = 0.01) = -1e-07 must be positive"));
+  r = run_frostmpm("test-model mechanical_model/broken_elastic" + plugin);
+  CHECK(r.exit_code == 1);
+  for (const char* rule : {"tangent dstress_yz/dstrain_yz = ", "not objective: ", "stress_xx and stress_yy do not swap",
+                           "is outside (0, max_p_wave_modulus() = "})
+    CHECK(has(line_with(r.output, rule), "violation: "));
+  CHECK(has(r.output, "parameter sets: 3 (the above, and each of youngs_modulus at 1 % and 99 % of its range)"));
+  CHECK(has(line_with(r.output, "tangent dstress_yz"), "(and 6002 more samples)"));  // 2001 states in each set
+  CHECK(has(r.output, "mechanical_model/broken_elastic: 4 contract rule(s) broken"));
+  r = run_frostmpm("test-model mechanical_model/broken_creep" + plugin);
+  CHECK(r.exit_code == 1);
+  for (const char* rule : {"initial_state() has 2 entries", "a zero strain increment changes the stress",
+                           "state 'creep_strain' = nan", "the integration fails (", "shear_modulus = nan"})
+    CHECK(has(line_with(r.output, rule), "violation: "));
+  CHECK(has(line_with(r.output, "shear_modulus = nan"), "no T, S_c or p_l given"));
+  CHECK(has(r.output, "mechanical_model/broken_creep: 5 contract rule(s) broken"));
   r = run_frostmpm("test-model physics/thermal");
   CHECK(r.exit_code == 2);
-  CHECK(has(r.output, "no contract check for kind 'physics'"));
+  CHECK(has(r.output, "no contract check for kind 'physics'; it checks sfcc, relative_permeability, "
+                      "absolute_permeability and mechanical_model models"));
 }

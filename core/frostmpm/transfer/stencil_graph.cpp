@@ -1,6 +1,7 @@
 #include "frostmpm/transfer/stencil_graph.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "frostmpm/parallel/parallel.hpp"
 
@@ -58,8 +59,71 @@ void StencilGraph::build(const StencilCache<Dim>& st, std::size_t nodes, bool sq
   });
   diagonal.resize(nodes);
   for (std::size_t i = 0; i < nodes; ++i) diagonal[i] = position(i, static_cast<int>(i));
+  fill_transpose();
 }
 
+template <int Dim>
+void StencilGraph::build_lattice(const UniformGrid<Dim>& grid, int radius,
+                                 const std::vector<std::vector<std::size_t>>& cliques) {
+  const std::size_t nodes = grid.node_count();
+  std::vector<std::vector<int>> extra(nodes);
+  for (const auto& clique : cliques)
+    for (std::size_t i : clique) extra[i].insert(extra[i].end(), clique.begin(), clique.end());
+  offsets.assign(nodes + 1, 0);
+  columns.clear();
+  std::vector<int> row;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    row.clear();
+    const auto ijk = grid.node_lattice(i);
+    std::array<int, Dim> lo{}, hi{}, at{};
+    for (int d = 0; d < Dim; ++d) {
+      lo[d] = std::max(ijk[d] - radius, -grid.ghost_layers);
+      hi[d] = std::min(ijk[d] + radius, grid.cells[d] + grid.ghost_layers);
+    }
+    at = lo;
+    while (true) {
+      row.push_back(static_cast<int>(grid.node_index(at)));
+      int d = 0;
+      while (d < Dim && ++at[d] > hi[d]) {
+        at[d] = lo[d];
+        ++d;
+      }
+      if (d == Dim) break;
+    }
+    for (std::size_t k : extra[i]) row.push_back(static_cast<int>(k));
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    columns.insert(columns.end(), row.begin(), row.end());
+    offsets[i + 1] = columns.size();
+  }
+  diagonal.resize(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) diagonal[i] = position(i, static_cast<int>(i));
+  fill_transpose();
+}
+
+void StencilGraph::fill_transpose() {
+  transpose.resize(columns.size());
+  parallel_for(rows(), [&](std::size_t i) {
+    for (std::size_t e = offsets[i]; e < offsets[i + 1]; ++e)
+      transpose[e] = position(static_cast<std::size_t>(columns[e]), static_cast<int>(i));
+  });
+}
+
+template <int Dim>
+void StencilGraph::build_scatter(const StencilCache<Dim>& st) {
+  const int K = st.per_particle();
+  scatter.resize(st.particles() * K * K);
+  parallel_for(st.particles(), [&](std::size_t p) {
+    const auto* n = st.nodes(p);
+    for (int a = 0; a < K; ++a)
+      for (int b = 0; b < K; ++b) scatter[(p * K + a) * K + b] = static_cast<int>(position(n[a], static_cast<int>(n[b])));
+  });
+}
+
+template void StencilGraph::build_lattice<2>(const UniformGrid<2>&, int, const std::vector<std::vector<std::size_t>>&);
+template void StencilGraph::build_lattice<3>(const UniformGrid<3>&, int, const std::vector<std::vector<std::size_t>>&);
+template void StencilGraph::build_scatter<2>(const StencilCache<2>&);
+template void StencilGraph::build_scatter<3>(const StencilCache<3>&);
 template void StencilGraph::build<2>(const StencilCache<2>&, std::size_t, bool,
                                      const std::vector<std::vector<std::size_t>>&);
 template void StencilGraph::build<3>(const StencilCache<3>&, std::size_t, bool,

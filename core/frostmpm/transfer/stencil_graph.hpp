@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "frostmpm/grid/uniform_grid.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
 
 namespace frostmpm {
@@ -17,6 +18,7 @@ struct StencilGraph {
   std::vector<int> columns;          ///< sorted column indices of each row
   std::vector<int> scatter;          ///< CSR position of (particle p, stencil slot a, slot b)
   std::vector<std::size_t> diagonal; ///< CSR position of (i, i); every node has one
+  std::vector<std::size_t> transpose; ///< CSR position of (j, i) for the entry (i, j) (the pattern is symmetric)
   /// The transfer topology it was built for (Transfer::topology_version(); the caller sets it).
   std::uint64_t topology_version = ~std::uint64_t{0};
 
@@ -28,8 +30,19 @@ struct StencilGraph {
   template <int Dim>
   void build(const StencilCache<Dim>& stencil, std::size_t nodes, bool squared = false,
              const std::vector<std::vector<std::size_t>>& cliques = {});
+  /// The pattern of every node with all nodes within `radius` lattice steps along each axis,
+  /// plus `cliques`: independent of where particles are, so a physics whose particles move keeps
+  /// one matrix (and its preconditioner's structure) for the whole run and only refreshes the
+  /// particle-to-entry map (build_scatter) when the stencil topology changes.
+  template <int Dim>
+  void build_lattice(const UniformGrid<Dim>& grid, int radius, const std::vector<std::vector<std::size_t>>& cliques = {});
+  /// scatter for the stencil's particles in this pattern (which must hold every pair).
+  template <int Dim>
+  void build_scatter(const StencilCache<Dim>& stencil);
   std::size_t rows() const { return offsets.empty() ? 0 : offsets.size() - 1; }
   std::size_t nonzeros() const { return columns.size(); }
+  /// Fills `transpose` (after the pattern is built).
+  void fill_transpose();
   /// CSR position of (row, col), which must be in the pattern.
   std::size_t position(std::size_t row, int col) const;
 };
