@@ -115,7 +115,8 @@ std::vector<Stage> ThermalPhysics::stages() {
           // The convective term ρ_l c_l q·∇T, when some physics provides the Darcy flux q.
           {"thermal.solve", Phase::Energy, {node_temperature_.read(), water_flux_.optional_read()},
            {node_temperature_.write()}, [this] { implicit_ ? solve_implicit() : solve_explicit(); }},
-          {"thermal.map_to_particles", Phase::MapToParticles, {node_temperature_.read(), x, vol, phi, T, d},
+          {"thermal.map_to_particles", Phase::MapToParticles,
+           {node_temperature_.read(), x, vol, phi, T, d, solid_velocity_.optional_read()},
            {temperature_.write(), deviation_.write(), temperature_pic_.write(), saturation_.write()},
            [this] { map_to_particles(); }}};
 }
@@ -394,6 +395,8 @@ void ThermalPhysics::map_to_particles() {
   }
   long clipped = 0, shedding = 0;
   double max_diffusivity = 0, min_capacity = std::numeric_limits<double>::infinity();
+  const auto v_skeleton = solid_velocity_.bound() ? solid_velocity_.values() : std::span<const double>{};
+  const double h_min = kernel_->grid().min_spacing();
 #pragma omp parallel for schedule(static) reduction(+ : clipped, shedding) reduction(max : max_diffusivity) \
     reduction(min : min_capacity) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
@@ -413,7 +416,17 @@ void ThermalPhysics::map_to_particles() {
     }
     const double a = sensible(p, phi[p]);
     const double grid_heat = a * T_mean + phi[p] * G_mean;  // PIC heat content Σ_i S_ip H_p(T_i)
-    const double deviation = keep * d[p];
+    // Material that moves across the grid: a deviation belongs to the particle's place among the
+    // nodes, so it is forgotten in proportion to the distance moved, Σ_i S_ip |v_i| Δt / h (all of
+    // it after a cell): numerical diffusion ∝ |v| h whatever the step, and no FLIP noise.
+    double moved = 0;
+    if (!v_skeleton.empty()) {
+      const auto v = kernel_->transfer().vector_at(p, v_skeleton);
+      double speed2 = 0;
+      for (int e = 0; e < kDim; ++e) speed2 += v[e] * v[e];
+      moved = std::min(1.0, dt_ * std::sqrt(speed2) / h_min);
+    }
+    const double deviation = keep * (1.0 - moved) * d[p];
     double T_new = table.invert(a, phi[p], grid_heat + deviation, hint_[p]);
     // Maximum principle: no new extreme beyond the old value and the nodes' new values. The
     // deviation the clip removes is handed to the grid below, so energy stays exact.

@@ -90,6 +90,8 @@ class ThermalPhysics final : public Physics {
   FieldHandle saturation_ = FieldHandle::particle("liquid_saturation");
   FieldHandle water_flux_ = FieldHandle::particle("water_flux", kDim, FieldKind::Vector);
   FieldHandle node_temperature_ = FieldHandle::node("temperature");
+  /// The skeleton's nodal velocity of the step (a mechanical physics): how far material moved.
+  FieldHandle solid_velocity_ = FieldHandle::node("solid_velocity", kDim);
   bool implicit_ = false, pic_properties_ = true;
   double flip_fraction_ = 1, subgrid_relaxation_ = 0, cfl_ = 0.5, advection_cfl_ = 0.9;
   double nonlinear_tolerance_ = 1e-6;

@@ -17,7 +17,9 @@ const std::map<std::string, std::string> kScenes = {
     {"FI", "configs/tutorials/frozen_inclusion.yaml"},   {"FC", "configs/tutorials/freezing_curves.yaml"},
     {"HF", "configs/verification/heat_flux.yaml"},       {"CV", "configs/verification/convective_surface.yaml"},
     {"DC", "configs/verification/darcy_column.yaml"},    {"NF", "configs/verification/neumann_freezing.yaml"},
-    {"KA", "configs/verification/kurylyk_advection.yaml"}, {"P1", "configs/paper/frozen_inclusion_case1.yaml"}};
+    {"KA", "configs/verification/kurylyk_advection.yaml"}, {"P1", "configs/paper/frozen_inclusion_case1.yaml"},
+    {"SW", "configs/verification/self_weight_column.yaml"}, {"VB", "configs/verification/vibrating_bar.yaml"},
+    {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"}};
 
 struct Case {
   int line = 0;

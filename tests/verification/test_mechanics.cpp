@@ -270,3 +270,40 @@ TEST_CASE("Mandel's problem: the pore pressure at the centre overshoots (Mandelâ
   CHECK(std::abs(peak_error[1]) < 0.01);
   CHECK(std::abs(peak_error[1]) < std::abs(peak_error[0]));
 }
+
+TEST_CASE("Neumann thaw in a column translated rigidly across the grid: the same front relative to the material, "
+          "energy balance at round-off", "[verification][mechanics][thermal]") {
+  TempDir dir;
+  // neumann_thaw.yaml at h = 0.01 m on a 0.06 m wide column; moved sideways by 0.05 m over the
+  // day (5 cells) by a velocity condition on every node (the skeleton's modulus is negligible:
+  // a rigid motion). The probe line x = 0.055 m stays inside the material all day. (On 0.02 m the
+  // moved front is 1.6 % deeper: a particle forgets its sub-cell heat as it crosses cells.)
+  const double h = 0.01;
+  auto sets = [&](bool moving) {
+    std::vector<std::string> s = {
+        "grid.cells=[12, 150]", "grid.cell_size=" + number(h),
+        "regions.0.shape={box: {min: [0, 0], max: [0.06, 1.5]}}",
+        "probes.0.from=[0.055, 1.5]", "probes.0.to=[0.055, 0.0]",
+        "probes.4.from=[0.055, 1.5]", "probes.4.to=[0.055, 0.0]"};
+    if (moving) {
+      s.push_back("physics.mechanical={}");
+      s.push_back("materials.soil.mechanical_model={model: linear_elastic, youngs_modulus: 1.0e-6, poisson_ratio: 0}");
+      s.push_back("boundary_conditions=[{type: temperature, nodes: {face: y_max}, value: 5.0}, {type: velocity, nodes: "
+                  "{box: {min: [0, 0], max: [0.12, 1.5]}}, x: " + number(0.05 / 86400) + ", y: 0}]");
+    }
+    return s;
+  };
+  const auto rest = run_scene(dir, "neumann_thaw.yaml", sets(false), "rest");
+  const auto moved = run_scene(dir, "neumann_thaw.yaml", sets(true), "moved");
+  const double front_rest = rest.rows.back()[rest.column("half_thawed_depth")];
+  const double front_moved = moved.rows.back()[moved.column("half_thawed_depth")];
+  std::printf("Neumann thaw, h = %.2g m: S_l = Â½ front %.5f m at rest, %.5f m moved 0.05 m (%+.3f %%)\n", h, front_rest,
+              front_moved, 100 * (front_moved / front_rest - 1));
+  CHECK(front_moved / front_rest == Approx(1.0).margin(0.005));
+  const std::string json = read_file(dir.file("moved/run.json"));
+  const auto at = json.find("\"thermal.energy_balance_error_relative\": ");
+  REQUIRE(at != std::string::npos);
+  const double balance = std::stod(json.substr(at + 41));
+  std::printf("   energy balance error (relative) %.3e\n", balance);
+  CHECK(balance < 1e-10);
+}
