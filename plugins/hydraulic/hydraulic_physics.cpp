@@ -28,6 +28,9 @@ ParamSchema HydraulicPhysics::schema() {
   s.integer("max_linear_iterations", "Krylov iterations per pressure solve before the run stops")
       .defaults_to(2000L)
       .at_least(1);
+  s.boolean("phase_change_source", "count the water volume freezing and thawing give up or take, ζ φ ΔS_l "
+             "(Eq. 48; the paper's Test C of Sec. 5.2.1 switches it off)")
+      .defaults_to(true);
   s.real("stabilization", "-",
          "τ of the polynomial pressure projection (Eqs. 66–67): adds τ/(2G) ∫(S−ΠS)ᵀ(S−ΠS) dV · Δp/Δt, G the "
          "material's shear_modulus; damps checkerboard pressure modes; 0 switches it off")
@@ -38,6 +41,7 @@ ParamSchema HydraulicPhysics::schema() {
 
 HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
   reference_gravity_ = p.real("reference_gravity");
+  phase_change_source_ = p.boolean("phase_change_source");
 }
 
 ParamSchema HydraulicPhysics::material_schema() const {
@@ -343,7 +347,8 @@ void HydraulicPhysics::update_source() {
     const double beta = (1.0 - phi[p]) * m.solid_expansion + phi[p] * s * m.water_expansion +
                         (1.0 - m.zeta) * n_c * m.ice_expansion;
     const double dT = T ? T[p] - T_prev_[p] : 0.0;
-    source_[p] = (m.zeta * phi[p] * (s - std::clamp(S_prev_[p], 0.0, 1.0)) - beta * dT) / dt_;
+    const double zeta = phase_change_source_ ? m.zeta : 0.0;
+    source_[p] = (zeta * phi[p] * (s - std::clamp(S_prev_[p], 0.0, 1.0)) - beta * dT) / dt_;
     S_prev_[p] = S[p];
     if (T) T_prev_[p] = T[p];
   });
@@ -496,6 +501,18 @@ void HydraulicPhysics::restored() {
   // The nodal state came back with the kernel's carried node fields; it belongs to this stencil.
   projected_version_ = kernel_->transfer().version();
   grid_valid_ = true;
+  std::fill(dp_->begin(), dp_->end(), 0.0);
+}
+
+/// The pressure system is built anew after a checkpoint, as a restart builds it: the matrix
+/// graph (a rigid plate's rows follow its nodes of the moment) and the preconditioner, with the
+/// refresh counters; the next solve starts from a zero increment, as a restart's does.
+void HydraulicPhysics::checkpoint_written() {
+  std::fill(dp_->begin(), dp_->end(), 0.0);
+  system_.reset();
+  preconditioner_built_ = false;
+  refresh_due_ = false;
+  iterations_after_refresh_ = 0;
 }
 
 std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const {

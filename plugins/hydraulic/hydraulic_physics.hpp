@@ -57,6 +57,7 @@ class HydraulicPhysics final : public Physics {
   void begin_step(double time, double dt) override;
   std::vector<PersistentArray> persistent_state() override;
   void restored() override;
+  void checkpoint_written() override;
   std::vector<std::pair<std::string, double>> statistics() const override;
   std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const override {
     return {{"hydraulic.linear_iterations", &step_iterations_}, {"hydraulic.relative_residual", &step_residuals_}};
@@ -117,6 +118,7 @@ class HydraulicPhysics final : public Physics {
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
   double mass_scaling_ = 1;
+  bool phase_change_source_ = true;
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;

@@ -4,6 +4,8 @@
 //   {type: velocity, nodes: ..., x: v(t), y: ...}   the components given follow time functions
 //   {type: traction, nodes: {face: ...}, normal: t(t), shear: t(t)}   or x: / y: components [Pa]
 //   {type: surcharge, nodes: {face: y_max, range: [a, b]}, value: q(t)}  a pressure pushing in
+//   {type: surcharge, particles: {box: ...}, normal: [0, -1], value: q(t)}  on the particles' outer
+//        faces (area: their extent across the normal), following the material as it moves
 //   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
 //                                                   the total force F [N, per m in 2-D] (Mandel)
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
@@ -105,13 +107,18 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     plates_.push_back(std::move(c));
   }
   auto add_traction = [&](BoundaryCondition* bc, std::array<TimeFunction, Dim> value) {
-    const bool face = bc->face_axis >= 0;
-    if (!face) throw bc->node->error(bc->type + " acts on a grid face: use nodes: {face: ..., range: [from, to]}");
     TractionCondition c;
     c.bc = bc;
+    c.value = std::move(value);
+    if (bc->on_particles) {
+      c.particles = bc->particles;
+      c.normal_axis = particle_normal_axis(*bc);
+      traction_bcs_.push_back(std::move(c));
+      return;  // it moves with the material: no fixed node to conflict with
+    }
+    if (bc->face_axis < 0) throw bc->node->error(bc->type + " acts on a grid face: use nodes: {face: ..., range: [from, to]}");
     c.nodes = bc->nodes;
     c.areas = bc->node_areas;
-    c.value = std::move(value);
     for (int d = 0; d < Dim; ++d) {
       if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
       for (std::size_t i : c.nodes)
@@ -127,7 +134,6 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     traction_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("traction")) {
-    on_nodes(bc);
     std::array<TimeFunction, Dim> value;
     bool by_components = false;
     for (int d = 0; d < Dim; ++d) by_components = by_components || bc->node->has(axis_name(d));
@@ -153,14 +159,32 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_traction(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("surcharge")) {
-    on_nodes(bc);
-    if (bc->face_axis < 0) throw bc->node->error("surcharge acts on a grid face: use nodes: {face: ...}");
+    int axis = bc->face_axis, side = bc->face_side;
+    if (bc->on_particles) {
+      axis = particle_normal_axis(*bc);
+      side = bc->node->child("normal").as_reals()[std::size_t(axis)] > 0 ? 1 : -1;
+    } else if (axis < 0) {
+      throw bc->node->error("surcharge acts on a grid face (nodes: {face: ...}) or on particles with an outward normal:");
+    }
     const TimeFunction q = TimeFunction::read(bc->node->child("value"), kMaxTraction, end);
     std::array<TimeFunction, Dim> value;
     // A pressure pushes into the material: against the outward normal.
-    value[bc->face_axis] = bc->face_side > 0 ? q.scaled(-1.0) : q;
+    value[axis] = side > 0 ? q.scaled(-1.0) : q;
     add_traction(bc, std::move(value));
   }
+}
+
+/// The axis of a particle condition's outward `normal:` ([0, -1]: the loaded faces face −y).
+template <int Dim>
+int MechanicalPhysics<Dim>::particle_normal_axis(const BoundaryCondition& bc) {
+  const ConfigNode n = bc.node->child("normal");
+  const auto v = n.as_reals();
+  int axis = -1, count = 0;
+  for (std::size_t d = 0; d < v.size(); ++d)
+    if (v[d] != 0) axis = int(d), ++count;
+  if (v.size() != std::size_t(Dim) || count != 1 || std::abs(v[std::size_t(axis)]) != 1.0)
+    throw n.error("expected the outward unit normal along an axis, e.g. [0, 1] for a top surface");
+  return axis;
 }
 
 template <int Dim>
@@ -218,6 +242,7 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
 // mechanical_physics.cpp).
 #define FROSTMPM_MECHANICAL_BOUNDARIES(D)                                                          \
   template void MechanicalPhysics<D>::read_boundaries(Kernel<D>&);                                 \
+  template int MechanicalPhysics<D>::particle_normal_axis(const BoundaryCondition&);               \
   template void MechanicalPhysics<D>::constrain(std::vector<double>&, double, double);             \
   template void MechanicalPhysics<D>::tie_plates(std::vector<double>&, double, double, bool);      \
   template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const;

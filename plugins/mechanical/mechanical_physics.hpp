@@ -64,11 +64,14 @@ class MechanicalPhysics final : public Physics {
     std::array<std::optional<TimeFunction>, Dim> value;
     std::array<double, 3> reaction{};  ///< force on the material over the last step [N (per m in 2-D)]
   };
-  /// A traction condition: force per area on face nodes.
+  /// A traction condition: force per area on face nodes, or on the surface of a set of
+  /// particles (which it follows as the material moves: `particles:` with an outward `normal:`).
   struct TractionCondition {
     const BoundaryCondition* bc = nullptr;
     std::vector<std::size_t> nodes;
     std::vector<double> areas;
+    std::vector<std::size_t> particles;
+    int normal_axis = -1;  ///< particles: the axis of the outward normal (their loaded face is ⟂ to it)
     std::array<TimeFunction, Dim> value;  ///< traction vector components [Pa]
     std::array<double, 3> applied{};      ///< force it applied over the last step
   };
@@ -92,6 +95,9 @@ class MechanicalPhysics final : public Physics {
   ParamSet params_;
   Kernel<Dim>* kernel_ = nullptr;
   double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
+  /// Nodes lighter than this fraction of the heaviest node take no force (predict()).
+  static constexpr double kGrazingMass = 1e-6;
+  double grazing_mass_ = 0;
   bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
   std::vector<MaterialData> materials_;
   std::vector<VelocityCondition> velocity_bcs_;
@@ -120,6 +126,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> saved_scalars_;
 
   void read_boundaries(Kernel<Dim>& kernel);
+  static int particle_normal_axis(const BoundaryCondition& bc);
   /// Sets the prescribed components of the nodal velocity `v` at time t; with `force_scale` > 0
   /// adds each condition's reaction (force_scale · (v_prescribed − v_free) per component).
   void constrain(std::vector<double>& v, double t, double force_scale);

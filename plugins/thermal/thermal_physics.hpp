@@ -141,6 +141,9 @@ class ThermalPhysics final : public Physics {
   bool advection_ = false;     ///< the scene has a Darcy flux (particle field water_flux)
   std::vector<double> advection_force_;  ///< convective term of this step, per node [W per m]
   double advected_rate_ = 0;   ///< Σ_i advection_force_ [W per m]
+  double deformation_heat_ = 0;  ///< heat change of the particles as the skeleton deformed them
+  double heat_after_step_ = 0;    ///< Σ V_p H_p at the end of the last step (a moving skeleton)
+  bool heat_after_step_valid_ = false;
   double advected_heat_ = 0;   ///< heat carried in by the flow so far (included in boundary_heat_)
   long nonlinear_total_ = 0, nonlinear_max_ = 0, linear_total_ = 0, rejected_substeps_ = 0, substeps_ = 0,
        clipped_ = 0;

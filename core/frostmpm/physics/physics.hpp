@@ -73,6 +73,10 @@ class Physics {
   /// a restart takes its size from the checkpoint, so stable_time_step() is next asked after
   /// that step, exactly as in the uninterrupted run.
   virtual void restored() {}
+  /// Called after a checkpoint was written: drop what restored() does not bring back (solver
+  /// caches, preconditioners, matrix graphs), so that the run goes on exactly as a restart
+  /// from this checkpoint would.
+  virtual void checkpoint_written() {}
   /// The force the boundary condition `bc` (of a type this physics owns) exerts on the
   /// material, [N] per metre of thickness in 2-D, for `reaction` probes; none when the
   /// physics does not track it.

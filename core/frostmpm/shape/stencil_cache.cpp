@@ -7,6 +7,11 @@
 
 namespace frostmpm {
 
+namespace {
+/// The round-off of a position in cell units, as shape_1d allows it.
+double tolerance(double xi) { return 16.0 * std::numeric_limits<double>::epsilon() * (std::abs(xi) + 2.0); }
+}  // namespace
+
 template <int Dim>
 long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const double> positions,
                                std::span<const double> half_sizes) {
@@ -35,7 +40,7 @@ long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const dou
         // Beyond round-off (shape_1d's own tolerance): a domain that ends on the edge, as every
         // lattice particle's does, keeps its weights.
         const double edge_lo = -grid.ghost_layers, edge_hi = grid.cells[d] + grid.ghost_layers;
-        const double tol = 16.0 * std::numeric_limits<double>::epsilon() * (std::abs(xi) + 2.0);
+        const double tol = tolerance(xi);
         if (xi - half < edge_lo - tol || xi + half > edge_hi + tol) {
           const double lo = std::max(xi - half, edge_lo), hi = std::min(xi + half, edge_hi);
           if (!(hi > lo)) {
@@ -48,10 +53,16 @@ long StencilCache<Dim>::update(const UniformGrid<Dim>& grid, std::span<const dou
       }
       base[d] = shape_1d(kind_, xi, h, half, w[d].data(), g[d].data());
       // A support node past the grid is harmless when its weight is zero (GIMP particles at
-      // the domain edge); it is then pointed at a valid node.
+      // the domain edge); it is then pointed at a valid node. A domain that ends past the edge
+      // by less than the round-off above was not clipped and may hold a ~1e-26 weight there
+      // (a moving particle pressed against a fixed face): that is round-off, dropped.
       for (int k = 0; k < width_; ++k) {
         const int node = base[d] + k;
         if (node >= -grid.ghost_layers && node <= grid.cells[d] + grid.ghost_layers) continue;
+        if (kind_ == ShapeKind::Gimp && std::abs(node - xi) >= 1.0 + half - 2.0 * tolerance(xi)) {
+          w[d][k] = g[d][k] = 0.0;
+          continue;
+        }
         if (w[d][k] != 0.0 || g[d][k] != 0.0) inside = false;
       }
     }

@@ -398,6 +398,7 @@ void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const 
   if (const auto carried = carried_node_fields(); !carried.empty())
     checkpoint.write_physics(kCarriedNodeFields, carried);
   checkpoint.commit();
+  for (auto& physics : physics_) physics->checkpoint_written();
   stats_.stage_seconds["kernel.checkpoint"] += std::chrono::duration<double>(Clock::now() - start).count();
 }
 
