@@ -1,15 +1,22 @@
 #!/usr/bin/python3
-"""The paper's thermo-hydraulic figures from FrostMPM runs (Yu et al. 2024, Sec. 5.1, Figs. 3–10).
+"""The paper's figures from FrostMPM runs (Yu et al. 2024, Secs. 5.1–5.2, Figs. 3–13).
 
     /usr/bin/python3 scripts/plot_paper.py inclusion OUT_1 OUT_2 OUT_3 [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py talik OUT_1 OUT_2 OUT_3 [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py contours OUT [--png FILE] [--frame N]
+    /usr/bin/python3 scripts/plot_paper.py thaw OUT_A OUT_B OUT_C OUT_D [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py mn OUT_R0.5 OUT_R1.5 [more pairs at other cell sizes] [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (VERIFICATION §3).
 talik: temperature at the centre point A and the equivalent hydraulic conductivity k_eq(t)
 (Fig. 10, right). contours: temperature contours of one frame of fields.h5 with the 0 °C isotherm
-(Figs. 3 and 7); the last frame unless --frame. Each OUT is a run folder (metrics.csv, fields.h5).
+(Figs. 3 and 7); the last frame unless --frame. thaw: the thaw consolidation of Sec. 5.2.1
+(configs/paper/thaw_consolidation.yaml, Tests A–D): settlement and thaw depth against time with
+the Neumann estimate and q H/E_oed (Fig. 12B), pore pressure against depth (Fig. 13A) and, for
+Test A at 1 h, p/q, S_c and k0/k (Fig. 13B); it writes FILE and FILE with _profiles before the
+extension. mn: settlement and excess pore pressure of configs/verification/thaw_consolidation_mn.yaml
+against Morgenstern & Nixon's closed form. Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -68,10 +75,153 @@ def contours(folder, png, frame):
     frostplot.save(fig, png)
 
 
+# ---- thaw consolidation (Sec. 5.2.1) ----------------------------------------------------------
+
+THAW_Q, THAW_H = 5.0e4, 0.1                              # surcharge [Pa], column [m]
+THAW_EOED = 4.0e5 * 0.7 / (1.3 * 0.4)                    # E(1 − ν)/((1 + ν)(1 − 2ν)) [Pa]
+THAW_TESTS = ["A (reference)", "B (no surcharge)", "C (no phase-change volume term)", "D (constant k)"]
+
+
+def neumann_front(k_thawed, c_thawed, k_frozen, c_frozen, latent, t_surface, t_initial, t_freeze=0.0):
+    """Two-phase Neumann thaw: X(t) = 2λ√(α_u t); returns the function X(t)."""
+    from scipy.optimize import brentq
+    from scipy.special import erf, erfc
+    au, af = k_thawed / c_thawed, k_frozen / c_frozen
+
+    def f(lam):
+        return (k_thawed * (t_surface - t_freeze) * np.exp(-lam * lam) / (np.sqrt(au) * erf(lam))
+                - k_frozen * (t_freeze - t_initial) * np.exp(-lam * lam * au / af) / (np.sqrt(af) * erfc(lam * np.sqrt(au / af)))
+                - lam * latent * np.sqrt(np.pi * au))
+    lam = brentq(f, 1e-6, 5.0)
+    return lambda t: 2 * lam * np.sqrt(au * np.asarray(t))
+
+
+def thaw_neumann_estimate():
+    """The paper's thermal data (φ 0.4, arithmetic mixing, S_l = 0.0887 at −1 °C from its SFCC),
+    a sharp front at 0 °C carrying the latent heat of the ice at −1 °C."""
+    phi, s_l = 0.4, 0.0887
+    k_t = 0.6 * 1.6 + phi * 0.6
+    c_t = 0.6 * 2750 * 720 + phi * 1000 * 4200
+    k_f = 0.6 * 1.6 + phi * (s_l * 0.6 + (1 - s_l) * 2.2)
+    c_f = 0.6 * 2750 * 720 + phi * (s_l * 1000 * 4200 + (1 - s_l) * 917 * 2060)
+    return neumann_front(k_t, c_t, k_f, c_f, phi * (1 - s_l) * 917 * 3.34e5, 20.0, -1.0)
+
+
+def depth_profile(frame, field, top=THAW_H):
+    """(depth below the fixed surface, values of `field`) of a 1-D column, sorted by depth."""
+    y = frame["coordinates"][:, 1]
+    order = np.argsort(top - y)
+    return (top - y)[order], np.asarray(frame["fields"][field])[order]
+
+
+def frame_at(frames, time):
+    return min(frames, key=lambda fr: abs(fr["time"] - time))
+
+
+def thaw(folders, png):
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    for i, folder in enumerate(folders):
+        m = metrics(folder)
+        a.plot(m["time_s"] / 3600, 1e3 * m["settlement"], label=THAW_TESTS[i] if i < 4 else folder)
+        if i == 0:
+            b.plot(m["time_s"] / 3600, 1e2 * m["thaw_depth"], label="FrostMPM, Test A")
+            t = np.linspace(0, m["time_s"][-1], 200)
+            b.plot(t / 3600, 1e2 * thaw_neumann_estimate()(t), "k--", lw=1, label="Neumann estimate (semi-infinite)")
+    small = 1e3 * THAW_Q * THAW_H / THAW_EOED
+    large = 1e3 * THAW_H * (1 - np.exp(-THAW_Q / THAW_EOED))
+    a.axhline(small, color="k", ls=":", lw=1)
+    a.axhline(large, color="k", ls="--", lw=1)
+    a.text(0.2, small, f" q H/E_oed = {small:.2f} mm (small strain)", va="bottom", fontsize=8)
+    a.text(0.2, large, f" H(1 − e^(−q/E_oed)) = {large:.2f} mm (logarithmic strain)", va="top", fontsize=8)
+    a.set(xlabel="t [h]", ylabel="settlement [mm]", title="settlement (paper Fig. 12B)")
+    a.legend(fontsize=8, loc="center right")
+    b.set(xlabel="t [h]", ylabel="thaw depth [cm]", title="0 °C isotherm below the surface")
+    b.legend(fontsize=8)
+    frostplot.save(fig, png)
+    # Fig. 13: pore pressure against depth in Tests A–C, and Test A at 1 h.
+    root, ext = os.path.splitext(png)
+    fig, axes = plt.subplots(1, 4, figsize=(15, 4.2), sharey=True)
+    for i, folder in enumerate(folders[:3]):
+        frames = frostplot.read_fields.read_frames(folder)
+        for hours in (1, 3, 6, 10):
+            fr = frame_at(frames, 3600 * hours)
+            d, p = depth_profile(fr, "pore_pressure")
+            axes[i].plot(p / THAW_Q, 1e2 * d, label=f"{fr['time'] / 3600:.0f} h")
+        axes[i].set(xlabel="p_l / q", title=f"Test {THAW_TESTS[i]}")
+        axes[i].legend(fontsize=8)
+    axes[0].set(ylabel="depth [cm]")
+    axes[0].invert_yaxis()
+    fr = frame_at(frostplot.read_fields.read_frames(folders[0]), 3600)
+    d, p = depth_profile(fr, "pore_pressure")
+    _, s_l = depth_profile(fr, "liquid_saturation")
+    _, phi = depth_profile(fr, "porosity")
+    # k0/k from the scene's models: van Genuchten–Mualem (m = 0.5) and Kozeny–Carman (φ0 = 0.4).
+    m_vg = 0.5
+    k_r = np.sqrt(s_l) * (1 - (1 - s_l ** (1 / m_vg)) ** m_vg) ** 2
+    kc = phi ** 3 / (1 - phi) ** 2 * (1 - 0.4) ** 2 / 0.4 ** 3
+    ax = axes[3]
+    ax.plot(p / THAW_Q, 1e2 * d, label="p_l / q")
+    ax.plot(1 - s_l, 1e2 * d, label="S_c")
+    ax2 = ax.twiny()
+    ax2.semilogx(1 / np.maximum(k_r * kc, 1e-30), 1e2 * d, "g", label="k0 / k")
+    ax2.set_xlabel("k0 / k", color="g")
+    front = 1e2 * float(np.interp(0.0, depth_profile(fr, "temperature")[1][::-1], d[::-1]))
+    ax.axhline(front, color="r", ls="--", lw=1)
+    ax.set(xlabel="p_l / q, S_c", title="Test A at 1 h (red: thaw front)")
+    ax.legend(fontsize=8, loc="lower left")
+    frostplot.save(fig, root + "_profiles" + ext)
+
+
+# ---- Morgenstern–Nixon thaw consolidation ------------------------------------------------------
+
+MN_P0, MN_M, MN_H = 1.0e4, 1.0e6, 0.3
+
+
+def mn_closed_form(R, x, t, c_v):
+    """Excess pore pressure u(x, t) of Morgenstern & Nixon (surcharge P0, no self-weight)."""
+    from scipy.special import erf
+    return MN_P0 * erf(x / (2 * np.sqrt(c_v * t))) / (erf(R) + np.exp(-R * R) / (np.sqrt(np.pi) * R))
+
+
+def mn_degree(R):
+    from scipy.special import erf
+    return 1 / (np.sqrt(np.pi) * R * erf(R) + np.exp(-R * R))
+
+
+def mn(folders, png):
+    alpha = 3.2581e-4  # the scene's two-phase Neumann front constant [m/√s]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    drawn = set()
+    for folder in folders:
+        summary = frostplot.run_summary(folder)
+        scene = summary.get("resolved_scene", {})
+        K = scene["materials"]["soil"]["absolute_permeability"]["k0"]
+        h = scene["grid"]["cell_size"][0]
+        c_v = K * MN_M / 9810.0
+        R = alpha / (2 * np.sqrt(c_v))
+        m = metrics(folder)
+        t = m["time_s"]
+        line, = a.plot(t / 3600, 1e3 * m["settlement"], marker=".", ms=3, lw=0.8, label=f"R = {R:.1f}, h = {1e3 * h:g} mm")
+        if R not in drawn:
+            drawn.add(R)
+            a.plot(t / 3600, 1e3 * MN_P0 * alpha * np.sqrt(t) * mn_degree(R) / MN_M, "k--", lw=1)
+            tt = t[-1]
+            x = np.linspace(0, alpha * np.sqrt(tt), 100)
+            b.plot(mn_closed_form(R, x, tt, c_v) / MN_P0, 1e2 * x, "k--", lw=1)
+        fr = frostplot.read_fields.read_frames(folder)[-1]
+        d, p = depth_profile(fr, "pore_pressure", top=MN_H)
+        b.plot(p / MN_P0, 1e2 * d, ".", ms=3, color=line.get_color())
+    a.set(xlabel="t [h]", ylabel="settlement [mm]", title="settlement (dashed: Morgenstern & Nixon)")
+    a.legend(fontsize=8)
+    b.set(xlabel="p_l / P0", ylabel="depth [cm]", title=f"pore pressure at the end (dashed: closed form)")
+    b.invert_yaxis()
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["inclusion", "talik", "contours"])
+    parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -81,6 +231,10 @@ def main():
         inclusion(args.folders, png)
     elif args.figure == "talik":
         talik(args.folders, png)
+    elif args.figure == "thaw":
+        thaw(args.folders, png)
+    elif args.figure == "mn":
+        mn(args.folders, png)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

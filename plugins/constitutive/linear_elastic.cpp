@@ -1,8 +1,16 @@
 // Isotropic linear elasticity in rate form (hypoelastic, paper Eq. 28 with D the Hooke tensor):
 //   Δσ′ = λ tr(Δε) I + 2G Δε,  G = E / (2(1 + ν)),  λ = E ν / ((1 + ν)(1 − 2ν)),
 // with a Young's modulus that may grow with the ice saturation S_c (frozen soil stiff, thawed
-// soil soft): E(S_c) = E + (E_frozen − E) S_c, ν fixed. In rate form a change of stiffness acts
-// on the increments only: ice melting at constant strain changes no stress.
+// soil soft): E(S_c) = E + (E_frozen − E) S_c, ν fixed. How a change of the modulus acts is a
+// choice (modulus_change):
+//   increments     on the strain increments only (rate form, the paper's Eq. 28): ice melting
+//                  at constant strain changes no stress;
+//   elastic_strain σ′ = E(S_c) D̂ : ε_e, the effective stress wholly elastic (D̂ the Hooke tensor
+//                  for E = 1): at constant strain a change of modulus scales the stress,
+//                  Δσ′ = E⁺ D̂ Δε + (E⁺/E − 1) σ′. Ice melting then releases the stress the
+//                  ice carried, and thawing soil carries only what its thawed skeleton can at
+//                  its strain (Morgenstern & Nixon's thawing soil). The state is E of the last
+//                  step, a scalar, so the rule is objective with the rotated stress.
 #include <algorithm>
 #include <cmath>
 
@@ -27,12 +35,24 @@ class LinearElastic final : public MechanicalModel {
         .defaults_to(0.0)
         .at_least(0)
         .at_most(1e13);
+    s.choice("modulus_change", {"increments", "elastic_strain"},
+             "how a modulus that changes with the ice acts: on the strain increments only (rate form, paper "
+             "Eq. 28), or on the elastic strain since the start (melting releases the stress the ice carried)")
+        .defaults_to("increments");
     return s;
   }
 
   explicit LinearElastic(const ParamSet& p)
-      : E_(p.real("youngs_modulus")), nu_(p.real("poisson_ratio")), E_frozen_(p.real("frozen_youngs_modulus")) {
+      : E_(p.real("youngs_modulus")),
+        nu_(p.real("poisson_ratio")),
+        E_frozen_(p.real("frozen_youngs_modulus")),
+        secant_(p.string("modulus_change") == "elastic_strain") {
     if (E_frozen_ == 0) E_frozen_ = E_;
+  }
+
+  std::vector<std::string> internal_variables() const override {
+    if (!secant_) return {};
+    return {"modulus_of_last_step"};
   }
 
   void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const override {
@@ -47,6 +67,12 @@ class LinearElastic final : public MechanicalModel {
       const double volumetric = lambda * (de[0] + de[1] + de[2]);
       for (int i = 0; i < 3; ++i) s[i] = s0[i] + volumetric + 2.0 * G * de[i];
       for (int i = 3; i < 6; ++i) s[i] = s0[i] + 2.0 * G * de[i];
+      if (secant_) {
+        // The modulus of the last step (0 before the first: no change yet).
+        const double E_last = in.state_start[p] > 0 ? in.state_start[p] : E;
+        for (int i = 0; i < 6; ++i) s[i] += (E / E_last - 1.0) * s0[i];
+        out.state[p] = E;
+      }
       if (!out.tangent.empty()) {
         double* D = out.tangent.data() + 36 * p;
         std::fill(D, D + 36, 0.0);
@@ -70,6 +96,7 @@ class LinearElastic final : public MechanicalModel {
   double modulus(double ice_saturation) const { return E_ + (E_frozen_ - E_) * std::clamp(ice_saturation, 0.0, 1.0); }
 
   double E_, nu_, E_frozen_;
+  bool secant_;
 };
 
 FROSTMPM_REGISTER(MechanicalModel, LinearElastic)

@@ -75,6 +75,14 @@ std::size_t CsvTable::column(const std::string& name) const {
   throw std::out_of_range("no column '" + name + "' in the CSV");
 }
 
+double run_counter(const std::string& out, const std::string& key) {
+  const std::string json = read_file(out + "/run.json");
+  const std::string quoted = "\"" + key + "\": ";
+  const auto at = json.find(quoted);
+  if (at == std::string::npos) throw std::out_of_range("run.json in " + out + " has no counter " + key);
+  return std::stod(json.substr(at + quoted.size()));
+}
+
 CsvTable read_csv(const std::string& path) {
   CsvTable table;
   std::ifstream in(path);

@@ -51,6 +51,10 @@ struct CsvTable {
 };
 CsvTable read_csv(const std::string& path);
 
+/// A counter of OUT/run.json's `run.counters` ("thermal.energy_balance_error_relative", ...);
+/// throws std::out_of_range naming it when absent.
+double run_counter(const std::string& out, const std::string& key);
+
 /// Writes `text` to `path`.
 void write_file(const std::string& path, const std::string& text);
 std::string read_file(const std::string& path);

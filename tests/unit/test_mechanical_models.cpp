@@ -86,7 +86,8 @@ const std::map<std::string, std::vector<std::string>>& mechanical_cases() {
         "youngs_modulus: 5.0e7, poisson_ratio: 0.0, frozen_youngs_modulus: 5.0e8",    // frozen 10× stiffer
         "youngs_modulus: 2.0e8, poisson_ratio: 0.49, frozen_youngs_modulus: 1.0e9",   // nearly incompressible
         "youngs_modulus: 1.0e5, poisson_ratio: -0.5",                                  // auxetic, soft
-        "youngs_modulus: 1.0e10, poisson_ratio: 0.25, frozen_youngs_modulus: 1.0e3"}}};  // ice softens
+        "youngs_modulus: 1.0e10, poisson_ratio: 0.25, frozen_youngs_modulus: 1.0e3",    // ice softens
+        "youngs_modulus: 1.0e6, poisson_ratio: 0.0, frozen_youngs_modulus: 2.0e7, modulus_change: elastic_strain"}}};
   return cases;
 }
 
@@ -321,4 +322,43 @@ TEST_CASE("an elastoplastic model keeps the contract, a wrong plastic tangent or
   lines = frostmpm::check_mechanical_model_contract(Throwing(), 10);
   REQUIRE(lines.size() == 1);
   CHECK(lines[0] == "integrate() throws instead of setting the failure flag: no convergence");
+}
+
+TEST_CASE("linear_elastic with modulus_change elastic_strain: melting ice scales the stress by E(S_c)/E of the "
+          "last step, a strain increment acts with the new modulus",
+          "[mechanical]") {
+  const auto model = make_model("linear_elastic", "youngs_modulus: 1.0e7, poisson_ratio: 0.2, frozen_youngs_modulus: "
+                                                  "1.0e9, modulus_change: elastic_strain");
+  REQUIRE(model->internal_variables() == std::vector<std::string>{"modulus_of_last_step"});
+  auto step = [&](const Voigt& strain, const Voigt& start, double S_c, double state_in, double& state_out) {
+    Voigt stress{};
+    const double ice[1] = {S_c};
+    std::uint8_t failed[1] = {0};
+    frostmpm::StressUpdateInput in;
+    in.strain_increment = strain;
+    in.stress_start = start;
+    in.state_start = {&state_in, 1};
+    in.ice_saturation = ice;
+    frostmpm::StressUpdateOutput out;
+    out.stress = stress;
+    out.state = {&state_out, 1};
+    out.failed = failed;
+    model->integrate(in, out);
+    return stress;
+  };
+  // The first step (state 0: no modulus yet) is the rate form, and records E.
+  double E = 0;
+  const Voigt shear{0, 0, 0, 0, 0, 1e-4};
+  Voigt sigma = step(shear, kStart, 1.0, 0.0, E);
+  CHECK(E == 1.0e9);
+  CHECK(sigma[5] - kStart[5] == Approx(2 * Elastic{1.0e9, 0.2}.G() * 1e-4).epsilon(1e-12));
+  // Half the ice melts at no strain: every component scales by E(0.5)/E(1) = 5.05e8/1e9.
+  double E_half = 0;
+  const Voigt melted = step({}, sigma, 0.5, E, E_half);
+  CHECK(E_half == Approx(5.05e8).epsilon(1e-14));
+  for (int k = 0; k < 6; ++k) CHECK(melted[k] == Approx(sigma[k] * 0.505).epsilon(1e-14));
+  // Refreezing at no strain scales it back.
+  double E_back = 0;
+  const Voigt frozen = step({}, melted, 1.0, E_half, E_back);
+  for (int k = 0; k < 6; ++k) CHECK(frozen[k] == Approx(sigma[k]).epsilon(1e-13));
 }

@@ -35,13 +35,6 @@ std::string with_flow(const TempDir& dir, const std::string& scene, const std::s
   return path;
 }
 
-double counter(const std::string& json, const std::string& key) {
-  const auto at = json.find("\"" + key + "\": ");
-  INFO("run.json counter " << key);
-  REQUIRE(at != std::string::npos);
-  return std::stod(json.substr(at + key.size() + 4));
-}
-
 struct Volumes {
   double inflow = 0, source = 0;
 };
@@ -51,8 +44,7 @@ Volumes run(const TempDir& dir, const std::string& scene, const std::string& set
   const auto r = run_frostmpm("run " + scene + " -o " + out + sets);
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
-  const std::string json = read_file(out + "/run.json");
-  return {counter(json, "hydraulic.boundary_inflow_volume"), counter(json, "hydraulic.source_volume")};
+  return {run_counter(out, "hydraulic.boundary_inflow_volume"), run_counter(out, "hydraulic.source_volume")};
 }
 
 }  // namespace
