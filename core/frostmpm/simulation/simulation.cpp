@@ -302,8 +302,10 @@ void Simulation::advance(double dt) {
     });
     positions_changed_ = false;
   }
-  particles_.begin_step();
-  for (auto& physics : physics_) physics->begin_step(time_, dt);
+  timed("kernel.begin_step", [&] {  // the history copy (stress_start ← stress, ...)
+    particles_.begin_step();
+    for (auto& physics : physics_) physics->begin_step(time_, dt);
+  });
   for (auto& stage : plan_.stages()) timed(stage.name, stage.run);
   time_ += dt;
   ++step_;
@@ -512,9 +514,16 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   const auto wall_start = Clock::now();
   const double time_start = time_;
   auto last_print = wall_start, last_checkpoint = wall_start;
+  // The step loop's work outside advance(), timed as stages too: run.json's stages then add up
+  // to the whole step loop but for metrics, frames and checkpoints.
+  auto timed = [&](const char* name, auto&& fn) {
+    const auto start = Clock::now();
+    fn();
+    stats_.stage_seconds[name] += std::chrono::duration<double>(Clock::now() - start).count();
+  };
   while (time_ < end_time_ - eps) {
     advance(loop.next_dt);
-    check_finite();
+    timed("kernel.check_finite", [&] { check_finite(); });
     const bool metrics_due = metrics_every_ <= 0 || time_ >= loop.next_metrics - eps || time_ >= end_time_ - eps;
     if (metrics_due) {
       write_metrics();
@@ -547,7 +556,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
     if (signal && !frame_due) write_frame();
     // The next step is chosen before a checkpoint is written, exactly as without one, and
     // saved with it: a restart continues with the same step and asks no physics for it.
-    loop.next_dt = plan_step(loop);
+    timed("kernel.plan_step", [&] { loop.next_dt = plan_step(loop); });
     const bool checkpoint_due =
         (checkpoint_every_steps_ > 0 && step_ % checkpoint_every_steps_ == 0) ||
         (checkpoint_every_minutes_ > 0 &&
