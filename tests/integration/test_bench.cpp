@@ -69,6 +69,60 @@ TEST_CASE("bench smoke test: the roofline's checksum is the same on 1 and 2 thre
   CHECK(roofline_checksum(1) == roofline_checksum(2));
 }
 
+namespace {
+
+/// The "checksum" value of elastic_kernel's --json line, as printed (17 digits).
+std::string elastic_checksum(int threads) {
+  // Enough steps for particles to change blocks (the scatter order is rebuilt), still tiny.
+  const auto r = run_command(binary_dir() + "/bin/elastic_kernel --particles 3000 --steps 40 --repeat 1 --json --threads " +
+                             std::to_string(threads));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto at = r.output.find("\"checksum\": ");
+  REQUIRE(at != std::string::npos);
+  return r.output.substr(at + 12, r.output.find('}', at) - at - 12);
+}
+
+}  // namespace
+
+TEST_CASE("bench smoke test: the elastic kernel's checksum is the same on 1 and 2 threads", "[bench]") {
+  CHECK(elastic_checksum(1) == elastic_checksum(2));
+}
+
+TEST_CASE("bench smoke test: mechanical_throughput prints the table with finite positive rates", "[bench]") {
+  TempDir dir;
+  // Smallest size, five scene steps, a tiny kernel run: a few seconds, exercising every column.
+  const auto r = run_command("/usr/bin/python3 " + source_dir() +
+                             "/bench/mechanical_throughput --sizes 30000 --threads 1,2 --repeat 1 --steps 5"
+                             " --kernel-work 1e5 --frostmpm " + frostmpm_exe() + " --kernel " + binary_dir() +
+                             "/bin/elastic_kernel --runs " + dir.file("runs") + " --out " + dir.file("table.csv") +
+                             " --baseline " + frostmpm_exe());
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.output.find("scene p-s/s") != std::string::npos);
+  CHECK(r.output.find("mechanical.predict") != std::string::npos);
+  CHECK(r.output.find("vs base") != std::string::npos);
+  const CsvTable table = read_csv(dir.file("table.csv"));
+  REQUIRE(table.rows.size() == 2);
+  std::set<double> threads;
+  for (const auto& row : table.rows) {
+    REQUIRE(row.size() == table.header.size());
+    CHECK(row[table.column("particles")] == 30000);
+    CHECK(row[table.column("cells_x")] == 150);
+    CHECK(row[table.column("cells_y")] == 50);
+    CHECK(row[table.column("steps")] >= 5);
+    threads.insert(row[table.column("threads")]);
+    for (const char* name : {"scene_ps_per_s", "scene_wall_s", "kernel_ps_per_s", "ratio", "scene_speedup",
+                             "kernel_speedup", "kernel_cpu_share", "baseline_ps_per_s", "vs_baseline"}) {
+      const double value = row[table.column(name)];
+      INFO(name << " = " << value);
+      CHECK(std::isfinite(value));
+      CHECK(value > 0);
+    }
+  }
+  CHECK(threads == std::set<double>{1, 2});
+}
+
 TEST_CASE("bench smoke test: throughput says to build first when frostmpm is missing", "[bench]") {
   TempDir dir;
   const auto r = run_command("/usr/bin/python3 " + source_dir() + "/bench/throughput --quick --frostmpm " +
