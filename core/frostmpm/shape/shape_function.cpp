@@ -1,5 +1,7 @@
 #include "frostmpm/shape/shape_function.hpp"
 
+#include "frostmpm/shape/shape_kernels.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -20,82 +22,12 @@ ShapeKind parse_shape_kind(const std::string& name) {
 
 std::string to_string(ShapeKind kind) { return shape_kind_names()[static_cast<int>(kind)]; }
 
-namespace {
-
-// uGIMP (Bardenhagen & Kober 2004; paper Eq. 58 with a linear grid basis and a hat-shaped
-// particle characteristic function): r = distance to node in cell units, lp = half-width.
-// A node within round-off `tol` of the support's edge gets exactly zero: otherwise a particle
-// whose support ends on the grid's last node would hold a ~1e-27 weight on a node past the grid.
-inline void gimp(double r, double lp, double tol, double& s, double& ds) {
-  const double a = std::abs(r);
-  const double sign = r < 0 ? -1.0 : 1.0;
-  if (a >= 1.0 + lp - tol) {
-    s = ds = 0.0;
-  } else if (a > 1.0 - lp) {
-    const double t = 1.0 + lp - a;
-    s = t * t / (4.0 * lp);
-    ds = -sign * t / (2.0 * lp);
-  } else if (a > lp) {
-    s = 1.0 - a;
-    ds = -sign;
-  } else {
-    s = 1.0 - (r * r + lp * lp) / (2.0 * lp);
-    ds = -r / lp;
-  }
-}
-
-inline void bspline(double r, double tol, double& s, double& ds) {
-  const double a = std::abs(r);
-  const double sign = r < 0 ? -1.0 : 1.0;
-  if (a >= 2.0 - tol) {
-    s = ds = 0.0;
-  } else if (a >= 1.0) {
-    const double t = 2.0 - a;
-    s = t * t * t / 6.0;
-    ds = -sign * 0.5 * t * t;
-  } else {
-    s = 2.0 / 3.0 - a * a + 0.5 * a * a * a;
-    ds = sign * (-2.0 * a + 1.5 * a * a);
-  }
-}
-
-}  // namespace
-
 int shape_1d(ShapeKind kind, double xi, double h, double half_size, double* weight, double* gradient) {
-  const double inv_h = 1.0 / h;
-  // The round-off of xi (a position minus the origin, over h) and of xi − node.
-  const double tol = 16.0 * std::numeric_limits<double>::epsilon() * (std::abs(xi) + 2.0);
   switch (kind) {
-    case ShapeKind::Linear: {
-      const int base = static_cast<int>(std::floor(xi));
-      const double f = xi - base;
-      weight[0] = 1.0 - f;
-      weight[1] = f;
-      gradient[0] = -inv_h;
-      gradient[1] = inv_h;
-      return base;
-    }
-    case ShapeKind::Gimp: {
-      // Support of width 3 centred on the nearest node.
-      const int base = static_cast<int>(std::floor(xi + 0.5)) - 1;
-      for (int k = 0; k < 3; ++k) {
-        double s, ds;
-        gimp(xi - (base + k), half_size, tol, s, ds);
-        weight[k] = s;
-        gradient[k] = ds * inv_h;
-      }
-      return base;
-    }
-    case ShapeKind::CubicBSpline: {
-      const int base = static_cast<int>(std::floor(xi)) - 1;
-      for (int k = 0; k < 4; ++k) {
-        double s, ds;
-        bspline(xi - (base + k), tol, s, ds);
-        weight[k] = s;
-        gradient[k] = ds * inv_h;
-      }
-      return base;
-    }
+    case ShapeKind::Linear: return shape_kernels::shape_1d<ShapeKind::Linear>(xi, h, half_size, weight, gradient);
+    case ShapeKind::Gimp: return shape_kernels::shape_1d<ShapeKind::Gimp>(xi, h, half_size, weight, gradient);
+    case ShapeKind::CubicBSpline:
+      return shape_kernels::shape_1d<ShapeKind::CubicBSpline>(xi, h, half_size, weight, gradient);
   }
   return 0;
 }
