@@ -20,24 +20,23 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
   for (int d = 0; d < Dim; ++d) block_count *= static_cast<std::size_t>(blocks_along[d]);
 
   // Block of every particle: from the lowest lattice node of its stencil (every node it
-  // writes lies within `width` columns of it along each axis).
+  // writes lies within `width` columns of it along each axis). A stencil is a tensor product of
+  // one run of nodes per axis and a node's index grows with each of its lattice coordinates, so
+  // the lowest node along every axis is the stencil's lowest index.
   std::vector<std::uint32_t> block_of(n);
-  std::vector<std::uint32_t> count(block_count, 0);
-  for (std::size_t p = 0; p < n; ++p) {
-    std::array<int, Dim> low{};
-    low.fill(std::numeric_limits<int>::max());
+  parallel_for(n, [&](std::size_t p) {
     const auto* nodes = stencil.nodes(p);
-    for (int k = 0; k < K; ++k) {
-      const auto ijk = grid.node_lattice(nodes[k]);
-      for (int d = 0; d < Dim; ++d) low[d] = std::min(low[d], ijk[d]);
-    }
+    std::uint32_t lowest = nodes[0];
+    for (int k = 1; k < K; ++k) lowest = std::min(lowest, nodes[k]);
+    const auto low = grid.node_lattice(lowest);
     std::size_t index = 0;
     for (int d = Dim - 1; d >= 0; --d)
       index = index * static_cast<std::size_t>(blocks_along[d]) +
               static_cast<std::size_t>((low[d] + grid.ghost_layers) / width);
     block_of[p] = static_cast<std::uint32_t>(index);
-    ++count[index];
-  }
+  });
+  std::vector<std::uint32_t> count(block_count, 0);
+  for (std::size_t p = 0; p < n; ++p) ++count[block_of[p]];
   auto colour_of = [&](std::size_t block) {
     int colour = 0;
     for (int d = 0; d < Dim; ++d) {
