@@ -7,12 +7,28 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "frostmpm/models/pore_space.hpp"
 #include "frostmpm/models/tensor3.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 
 namespace frostmpm::mechanical {
+
+namespace {
+
+/// f(std::integral_constant<int, 3^Dim>) for GIMP stencils — loops over the support of a fixed
+/// length, which the compiler unrolls — and f(K) for any other support size.
+template <int Dim, class F>
+void for_support(int K, F&& f) {
+  constexpr int gimp = Dim == 2 ? 9 : 27;
+  if (K == gimp)
+    f(std::integral_constant<int, gimp>{});
+  else
+    f(K);
+}
+
+}  // namespace
 
 template <int Dim>
 ParamSchema MechanicalPhysics<Dim>::schema() {
@@ -152,7 +168,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   previous_T_.assign(n, 0.0);
   failed_.assign(n, 0);
   for (auto* v : {&mass_, &drag_, &weight_}) v->assign(nodes, 0.0);
-  for (auto* v : {&force_, &momentum_, &start_velocity_}) v->assign(nodes * Dim, 0.0);
+  for (auto* v : {&force_, &momentum_, &start_velocity_, &mapped_velocity_}) v->assign(nodes * Dim, 0.0);
 }
 
 template <int Dim>
@@ -188,16 +204,32 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
 }
 
 template <int Dim>
-void MechanicalPhysics<Dim>::densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const {
-  const auto& m = materials_[kernel_->transfer().material(p)];
-  const double phi = porosity_.values()[p];
-  const double S = saturation_.bound() ? std::clamp(saturation_.values()[p], 0.0, 1.0) : 1.0;
+typename MechanicalPhysics<Dim>::DensityView MechanicalPhysics<Dim>::density_view() const {
+  return {materials_.data(),
+          kernel_->transfer().materials().data(),
+          porosity_.values().data(),
+          saturation_.bound() ? saturation_.values().data() : nullptr,
+          particle_mass_.empty() ? nullptr : particle_mass_.data(),
+          volume_.values().data()};
+}
+
+template <int Dim>
+inline void MechanicalPhysics<Dim>::DensityView::operator()(std::size_t p, double& rho_m, double& skeleton,
+                                                            double& n_l) const {
+  const auto& m = materials[material[p]];
+  const double phi = porosity[p];
+  const double S = saturation ? std::clamp(saturation[p], 0.0, 1.0) : 1.0;
   n_l = phi * S;
   skeleton = (1.0 - phi) * m.solid_density + phi * (1.0 - S) * m.ice_density;
   rho_m = skeleton + n_l * m.water_density;
   // Without pore-water flow the mixture is one phase whose mass each particle keeps (a
   // total-stress analysis): the density follows the volume.
-  if (!particle_mass_.empty()) rho_m = skeleton = particle_mass_[p] / volume_.values()[p];
+  if (particle_mass) rho_m = skeleton = particle_mass[p] / volume[p];
+}
+
+template <int Dim>
+void MechanicalPhysics<Dim>::densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const {
+  density_view()(p, rho_m, skeleton, n_l);
 }
 
 template <int Dim>
@@ -324,17 +356,23 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   const auto vol = volume_.values();
   const auto v = velocity_.values();
   const auto inertia = inertia_.values();
-  const int K = st.per_particle();
   std::fill(mass_.begin(), mass_.end(), 0.0);
   std::fill(momentum_.begin(), momentum_.end(), 0.0);
-  transfer.scatter([&](std::size_t p) {
-    const auto* nodes = st.nodes(p);
-    const auto* w = st.weights(p);
-    const double m = vol[p] * inertia[p];
-    for (int k = 0; k < K; ++k) {
-      mass_[nodes[k]] += w[k] * m;
-      for (int d = 0; d < Dim; ++d) momentum_[nodes[k] * Dim + d] += w[k] * m * v[p * Dim + d];
-    }
+  double* mass = mass_.data();
+  double* momentum = momentum_.data();
+  for_support<Dim>(st.per_particle(), [&](auto K) {
+    transfer.scatter([&](std::size_t p) {
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      const double m = vol[p] * inertia[p];
+      std::array<double, Dim> vp;
+      for (int d = 0; d < Dim; ++d) vp[d] = v[p * Dim + d];
+      for (int k = 0; k < K; ++k) {
+        const double wm = w[k] * m;
+        mass[nodes[k]] += wm;
+        for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += wm * vp[d];
+      }
+    });
   });
   auto& vn = node_velocity_.vector();
   parallel_for(mass_.size(), [&](std::size_t i) {
@@ -363,6 +401,10 @@ void MechanicalPhysics<Dim>::update_stress() {
     std::copy(T.begin(), T.end(), previous_T_.begin());
     primed_ = true;
   }
+  // The skeleton's inertia follows the new porosity (and the volume of the step's start).
+  auto inertia = inertia_.mutable_values();
+  const DensityView density = density_view();
+  const bool two_phase = liquid_drag_.bound();
   long invalid = -1;
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
@@ -409,6 +451,9 @@ void MechanicalPhysics<Dim>::update_stress() {
     std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
     if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
     if (thermal) previous_T_[p] = T[p];
+    double rho_m, skeleton, n_l;
+    density(p, rho_m, skeleton, n_l);
+    inertia[p] = mass_scaling_ * (two_phase ? skeleton : rho_m);
   }
   if (invalid >= 0) {
     std::ostringstream msg;
@@ -459,13 +504,6 @@ void MechanicalPhysics<Dim>::update_stress() {
   }
   for (std::size_t p = 0; p < n; ++p)
     if (failed_[p]) report_failure(p);
-
-  auto inertia = inertia_.mutable_values();
-  parallel_for(n, [&](std::size_t p) {
-    double rho_m, skeleton, n_l;
-    densities(p, rho_m, skeleton, n_l);
-    inertia[p] = mass_scaling_ * (liquid_drag_.bound() ? skeleton : rho_m);
-  });
 }
 
 template <int Dim>
@@ -496,32 +534,49 @@ void MechanicalPhysics<Dim>::predict() {
   std::fill(force_.begin(), force_.end(), 0.0);
   std::fill(drag_.begin(), drag_.end(), 0.0);
   std::fill(weight_.begin(), weight_.end(), 0.0);
-  transfer.scatter([&](std::size_t p) {
-    const auto* nodes = st.nodes(p);
-    const auto* w = st.weights(p);
-    const auto* grad = st.gradients(p);
-    double rho_m, skeleton, n_l;
-    densities(p, rho_m, skeleton, n_l);
-    // Total stress σ′ − p I, tension positive.
-    double total[6];
-    for (int i = 0; i < 6; ++i) total[i] = sigma[6 * p + i];
-    if (!pl.empty()) {
-      const double pressure = transfer.value_at(p, pl);
-      for (int i = 0; i < 3; ++i) total[i] -= pressure;
-    }
-    const double V = vol[p];
-    for (int a = 0; a < K; ++a) {
-      const std::size_t i = nodes[a];
-      for (int d = 0; d < Dim; ++d) {
-        double internal = 0;
-        for (int e = 0; e < Dim; ++e) internal += total[tensor3::kVoigt[d][e]] * grad[a * Dim + e];
-        double f = -V * internal + w[a] * V * rho_m * g[d];
-        if (two_phase) f += w[a] * V * R[p * Dim + d];
-        force_[i * Dim + d] += f;
+  const DensityView density = density_view();
+  double* force = force_.data();
+  double* weight = weight_.data();
+  double* drag = drag_.data();
+  // One loop per combination of the liquid's reaction and the pore pressure, so that neither is
+  // tested per node.
+  auto scatter_forces = [&](auto support, auto with_liquid, auto with_pressure) {
+    constexpr bool liquid = decltype(with_liquid)::value, pressure = decltype(with_pressure)::value;
+    transfer.scatter([&](std::size_t p) {
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      const auto* grad = st.gradients(p);
+      double rho_m, skeleton, n_l;
+      density(p, rho_m, skeleton, n_l);
+      // Total stress σ′ − p I, tension positive.
+      double total[6];
+      for (int i = 0; i < 6; ++i) total[i] = sigma[6 * p + i];
+      if constexpr (pressure) {
+        const double p_l = transfer.value_at(p, pl);
+        for (int i = 0; i < 3; ++i) total[i] -= p_l;
       }
-      weight_[i] += w[a] * V * rho_m;
-      if (two_phase) drag_[i] += w[a] * V * k[p];
-    }
+      const double V = vol[p];
+      for (int a = 0; a < support; ++a) {
+        const std::size_t i = nodes[a];
+        for (int d = 0; d < Dim; ++d) {
+          double internal = 0;
+          for (int e = 0; e < Dim; ++e) internal += total[tensor3::kVoigt[d][e]] * grad[a * Dim + e];
+          double f = -V * internal + w[a] * V * rho_m * g[d];
+          if constexpr (liquid) f += w[a] * V * R[p * Dim + d];
+          force[i * Dim + d] += f;
+        }
+        weight[i] += w[a] * V * rho_m;
+        if constexpr (liquid) drag[i] += w[a] * V * k[p];
+      }
+    });
+  };
+  using yes = std::true_type;
+  using no = std::false_type;
+  for_support<Dim>(K, [&](auto support) {
+    if (two_phase)
+      pl.empty() ? scatter_forces(support, yes{}, no{}) : scatter_forces(support, yes{}, yes{});
+    else
+      pl.empty() ? scatter_forces(support, no{}, no{}) : scatter_forces(support, no{}, yes{});
   });
   const auto half = half_size_.values();
   for (auto& c : traction_bcs_) {
@@ -661,44 +716,55 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   const auto inertia = inertia_.values();
   const int K = st.per_particle();
   const std::size_t n = kernel_->particle_count();
+  // The velocity mapped at the start (before the conditions acted, so that a prescribed
+  // velocity reaches the particles), once per node.
+  double* mapped = mapped_velocity_.data();
+  parallel_for(mass_.size(), [&](std::size_t i) {
+    for (int d = 0; d < Dim; ++d) mapped[i * Dim + d] = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
+  });
+  const double* start = start_velocity_.data();
+  const double* vi = v_new.data();
   double kinetic = 0;
+  auto update = [&](auto support, auto with_trapezoid) {
+    constexpr bool trapezoid = decltype(with_trapezoid)::value;
 #pragma omp parallel for schedule(static) reduction(+ : kinetic) if (n >= kParallelMinimum)
-  for (std::size_t p = 0; p < n; ++p) {
-    const auto* nodes = st.nodes(p);
-    const auto* w = st.weights(p);
-    std::array<double, Dim> dv{}, pic{}, move{};
-    for (int a = 0; a < K; ++a) {
-      const std::size_t i = nodes[a];
-      for (int d = 0; d < Dim; ++d) {
-        // FLIP increment from the velocity mapped at the start (before the conditions acted,
-        // so a prescribed velocity reaches the particles).
-        const double mapped = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
-        dv[d] += w[a] * (v_new[i * Dim + d] - mapped);
-        pic[d] += w[a] * v_new[i * Dim + d];
-        move[d] += w[a] * (trapezoidal_ ? 0.5 * (start_velocity_[i * Dim + d] + v_new[i * Dim + d])
-                                        : start_velocity_[i * Dim + d]);
+    for (std::size_t p = 0; p < n; ++p) {
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      std::array<double, Dim> dv{}, pic{}, move{};
+      for (int a = 0; a < support; ++a) {
+        const std::size_t i = nodes[a];
+        for (int d = 0; d < Dim; ++d) {
+          // FLIP increment from the mapped velocity.
+          dv[d] += w[a] * (vi[i * Dim + d] - mapped[i * Dim + d]);
+          pic[d] += w[a] * vi[i * Dim + d];
+          if constexpr (trapezoid)
+            move[d] += w[a] * (0.5 * (start[i * Dim + d] + vi[i * Dim + d]));
+          else
+            move[d] += w[a] * start[i * Dim + d];
+        }
       }
+      double speed2 = 0;
+      for (int d = 0; d < Dim; ++d) {
+        const double step = dt_ * move[d];
+        x[p * Dim + d] += step;
+        u[p * Dim + d] += step;
+        v[p * Dim + d] = flip_ * (v[p * Dim + d] + dv[d]) + (1.0 - flip_) * pic[d];
+        speed2 += v[p * Dim + d] * v[p * Dim + d];
+      }
+      kinetic += 0.5 * vol[p] * inertia[p] * speed2;
     }
-    double speed2 = 0;
-    for (int d = 0; d < Dim; ++d) {
-      const double step = dt_ * move[d];
-      x[p * Dim + d] += step;
-      u[p * Dim + d] += step;
-      v[p * Dim + d] = flip_ * (v[p * Dim + d] + dv[d]) + (1.0 - flip_) * pic[d];
-      speed2 += v[p * Dim + d] * v[p * Dim + d];
-    }
-    kinetic += 0.5 * vol[p] * inertia[p] * speed2;
-  }
+  };
+  for_support<Dim>(K, [&](auto support) {
+    trapezoidal_ ? update(support, std::true_type{}) : update(support, std::false_type{});
+  });
   // The kinetic energy with the inertia the step used (mass scaling included: that is what must
   // stay small against the work for a scaled run to be quasi-static).
   kinetic_energy_ = kinetic;
   // The work of gravity, tractions and plate loads over the step, with the step's mean velocity
   // at each node the force acts on.
   const auto g = kernel_->gravity();
-  auto mean_velocity = [&](std::size_t i, int d) {
-    const double old = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
-    return 0.5 * (old + v_new[i * Dim + d]);
-  };
+  auto mean_velocity = [&](std::size_t i, int d) { return 0.5 * (mapped[i * Dim + d] + v_new[i * Dim + d]); };
   double work = 0;
   for (std::size_t i = 0; i < mass_.size(); ++i) {
     if (weight_[i] == 0) continue;

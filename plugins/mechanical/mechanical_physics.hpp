@@ -118,6 +118,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<std::uint8_t> failed_;
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
+  std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP
 
   // ---- step and counters
   double time_ = 0, dt_ = 0;
@@ -135,6 +136,15 @@ class MechanicalPhysics final : public Physics {
   void tie_plates(std::vector<double>& v, double t, double dt, bool with_drag);
   /// ρ_m, the skeleton's inertia per volume and n_l of particle p (S_l from the thermal physics, else 1).
   void densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
+  /// densities() with what it reads fetched once, for loops over particles (a handle's values()
+  /// and the kernel's transfer() are calls, as costly as the arithmetic when made per particle).
+  struct DensityView {
+    const MaterialData* materials;
+    const std::uint16_t* material;
+    const double *porosity, *saturation, *particle_mass, *volume;  ///< saturation, particle_mass: null if none
+    void operator()(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
+  };
+  DensityView density_view() const;
   void map_to_grid();
   void update_stress();
   void predict();
