@@ -79,20 +79,32 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
       std::fill_n(node_out + p * K, K, 0u);
       continue;
     }
-    // Tensor product over the width^Dim support nodes (axis 0 fastest).
+    // Tensor product over the width^Dim support nodes (axis 0 fastest). A support wholly on the
+    // grid (all but the edge particles) needs no clamping: its nodes are the first one plus
+    // fixed strides.
     std::uint32_t* node_p = node_out + p * K;
     double* weight_p = weight_out + p * K;
     double* gradient_p = gradient_out + p * K * Dim;
+    bool on_grid = true;
+    for (int d = 0; d < Dim; ++d)
+      on_grid = on_grid && base[d] >= -grid.ghost_layers && base[d] + width - 1 <= grid.cells[d] + grid.ghost_layers;
+    const std::size_t first = on_grid ? grid.node_index(base) : 0;
+    std::array<std::size_t, Dim> stride{};
+    for (int d = 0, s = 1; d < Dim; s *= grid.nodes_along(d), ++d) stride[d] = static_cast<std::size_t>(s);
 #pragma GCC unroll 64
     for (std::size_t k = 0; k < K; ++k) {
       std::size_t rest = k;
       std::array<int, Dim> offset{}, ijk{};
+      std::size_t index = first;
       for (int d = 0; d < Dim; ++d) {
         offset[d] = static_cast<int>(rest % width);
         rest /= width;
-        ijk[d] = std::clamp(base[d] + offset[d], -grid.ghost_layers, grid.cells[d] + grid.ghost_layers);
+        if (on_grid)
+          index += static_cast<std::size_t>(offset[d]) * stride[d];
+        else
+          ijk[d] = std::clamp(base[d] + offset[d], -grid.ghost_layers, grid.cells[d] + grid.ghost_layers);
       }
-      const std::uint32_t node = static_cast<std::uint32_t>(grid.node_index(ijk));
+      const std::uint32_t node = static_cast<std::uint32_t>(on_grid ? index : grid.node_index(ijk));
       if (node_p[k] != node) topology = true;
       node_p[k] = node;
       double weight = 1.0;
