@@ -1,5 +1,7 @@
 #include "frostmpm/particles/particle_store.hpp"
 
+#include "frostmpm/parallel/parallel.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -51,7 +53,11 @@ void ParticleStore::begin_step() {
   for (const auto& name : history_) {
     const auto& current = fields_.at(name).values;
     auto& start = fields_.at(history_name(name)).values;
-    std::copy(current.begin(), current.end(), start.begin());
+    const std::size_t n = current.size();
+    const double* from = current.data();
+    double* to = start.data();
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (std::size_t i = 0; i < n; ++i) to[i] = from[i];
   }
 }
 
