@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -27,6 +28,10 @@ void for_support(int K, F&& f) {
   else
     f(K);
 }
+
+/// The most nodes a particle's support has (cubic B-splines in 3-D): the size of the per-particle
+/// buffers the scatters fill before adding into the nodes.
+constexpr int kMaxSupport = 64;
 
 }  // namespace
 
@@ -234,6 +239,7 @@ void MechanicalPhysics<Dim>::densities(std::size_t p, double& rho_m, double& ske
 
 template <int Dim>
 void MechanicalPhysics<Dim>::initialize() {
+  step_limit_valid_ = false;
   // F = I; the particles' moduli from the models' bounds until the first stress update.
   auto F = deformation_.mutable_values();
   const std::size_t n = kernel_->particle_count();
@@ -330,6 +336,8 @@ void MechanicalPhysics<Dim>::begin_step(double time, double dt) {
 
 template <int Dim>
 double MechanicalPhysics<Dim>::stable_time_step() const {
+  if (step_limit_valid_) return cfl_ * step_limit_;
+  // The same limit as map_to_particles takes.
   const double h = kernel_->grid().min_spacing();
   const auto v = velocity_.values();
   const auto inertia = inertia_.values();
@@ -351,6 +359,7 @@ double MechanicalPhysics<Dim>::stable_time_step() const {
 
 template <int Dim>
 void MechanicalPhysics<Dim>::map_to_grid() {
+  step_limit_valid_ = false;  // the step changes the moduli, the inertia and the velocities
   const auto& transfer = kernel_->transfer();
   const auto& st = transfer.stencil();
   const auto vol = volume_.values();
@@ -367,10 +376,15 @@ void MechanicalPhysics<Dim>::map_to_grid() {
       const double m = vol[p] * inertia[p];
       std::array<double, Dim> vp;
       for (int d = 0; d < Dim; ++d) vp[d] = v[p * Dim + d];
+      double m_k[kMaxSupport], p_k[kMaxSupport * Dim];  // contributions first, as in predict()
       for (int k = 0; k < K; ++k) {
         const double wm = w[k] * m;
-        mass[nodes[k]] += wm;
-        for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += wm * vp[d];
+        m_k[k] = wm;
+        for (int d = 0; d < Dim; ++d) p_k[k * Dim + d] = wm * vp[d];
+      }
+      for (int k = 0; k < K; ++k) {
+        mass[nodes[k]] += m_k[k];
+        for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += p_k[k * Dim + d];
       }
     });
   });
@@ -463,7 +477,8 @@ void MechanicalPhysics<Dim>::update_stress() {
     throw NumericalBlowUp(msg.str());
   }
 
-  // The constitutive models, one batch per material range.
+  // The constitutive models: one batch per material range, cut into fixed chunks that the
+  // threads share (every point is integrated on its own, so the chunks change no result).
   auto sigma = stress_.mutable_values();
   const auto S = saturation_.bound() ? saturation_.values() : std::span<const double>{};
   const auto pl = pore_pressure_.bound() ? pore_pressure_.values() : std::span<const double>{};
@@ -496,14 +511,42 @@ void MechanicalPhysics<Dim>::update_stress() {
     out.failed = {failed_.data() + r.begin, count};
     out.p_wave_modulus = {wave_modulus_.data() + r.begin, count};
     out.shear_modulus = shear_.mutable_values().subspan(r.begin, count);
-    m.model->integrate(in, out);
+    constexpr std::size_t kChunk = 4096;
+    const std::size_t chunks = (count + kChunk - 1) / kChunk;
+    std::vector<std::exception_ptr> errors(chunks);  // a model that throws: the first chunk's, rethrown here
+#pragma omp parallel for schedule(static) if (chunks > 1)
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t b = c * kChunk, k = std::min(kChunk, count - b);
+      auto part = [&](auto span, std::size_t width) { return span.empty() ? span : span.subspan(b * width, k * width); };
+      StressUpdateInput ci = in;
+      ci.strain_increment = part(in.strain_increment, 6);
+      ci.stress_start = part(in.stress_start, 6);
+      ci.state_start = part(in.state_start, nv);
+      ci.temperature = part(in.temperature, 1);
+      ci.ice_saturation = part(in.ice_saturation, 1);
+      ci.pore_pressure = part(in.pore_pressure, 1);
+      StressUpdateOutput co = out;
+      co.stress = part(out.stress, 6);
+      co.state = part(out.state, nv);
+      co.failed = part(out.failed, 1);
+      co.p_wave_modulus = part(out.p_wave_modulus, 1);
+      co.shear_modulus = part(out.shear_modulus, 1);
+      try {
+        m.model->integrate(ci, co);
+      } catch (...) {
+        errors[c] = std::current_exception();
+      }
+    }
+    for (const auto& error : errors)
+      if (error) std::rethrow_exception(error);
     for (std::size_t k = 0; k < nv; ++k) {
       auto values = variables_[m.variables[k]].mutable_values();
       for (std::size_t i = 0; i < count; ++i) values[r.begin + i] = state_out_[i * nv + k];
     }
   }
-  for (std::size_t p = 0; p < n; ++p)
-    if (failed_[p]) report_failure(p);
+  if (const auto first = std::find_if(failed_.begin(), failed_.end(), [](std::uint8_t f) { return f != 0; });
+      first != failed_.end())
+    report_failure(std::size_t(first - failed_.begin()));
 }
 
 template <int Dim>
@@ -556,17 +599,25 @@ void MechanicalPhysics<Dim>::predict() {
         for (int i = 0; i < 3; ++i) total[i] -= p_l;
       }
       const double V = vol[p];
+      // The contributions first, then the additions into the nodes (each node's in the same
+      // order): the arithmetic is not held up by stores that might alias its inputs.
+      double f_a[kMaxSupport * Dim], weight_a[kMaxSupport], drag_a[kMaxSupport];
       for (int a = 0; a < support; ++a) {
-        const std::size_t i = nodes[a];
         for (int d = 0; d < Dim; ++d) {
           double internal = 0;
           for (int e = 0; e < Dim; ++e) internal += total[tensor3::kVoigt[d][e]] * grad[a * Dim + e];
           double f = -V * internal + w[a] * V * rho_m * g[d];
           if constexpr (liquid) f += w[a] * V * R[p * Dim + d];
-          force[i * Dim + d] += f;
+          f_a[a * Dim + d] = f;
         }
-        weight[i] += w[a] * V * rho_m;
-        if constexpr (liquid) drag[i] += w[a] * V * k[p];
+        weight_a[a] = w[a] * V * rho_m;
+        if constexpr (liquid) drag_a[a] = w[a] * V * k[p];
+      }
+      for (int a = 0; a < support; ++a) {
+        const std::size_t i = nodes[a];
+        for (int d = 0; d < Dim; ++d) force[i * Dim + d] += f_a[a * Dim + d];
+        weight[i] += weight_a[a];
+        if constexpr (liquid) drag[i] += drag_a[a];
       }
     });
   };
@@ -724,10 +775,11 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   });
   const double* start = start_velocity_.data();
   const double* vi = v_new.data();
-  double kinetic = 0;
+  const double h = kernel_->grid().min_spacing();
+  double kinetic = 0, limit = std::numeric_limits<double>::infinity();
   auto update = [&](auto support, auto with_trapezoid) {
     constexpr bool trapezoid = decltype(with_trapezoid)::value;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic) if (n >= kParallelMinimum)
+#pragma omp parallel for schedule(static) reduction(+ : kinetic) reduction(min : limit) if (n >= kParallelMinimum)
     for (std::size_t p = 0; p < n; ++p) {
       const auto* nodes = st.nodes(p);
       const auto* w = st.weights(p);
@@ -753,11 +805,17 @@ void MechanicalPhysics<Dim>::map_to_particles() {
         speed2 += v[p * Dim + d] * v[p * Dim + d];
       }
       kinetic += 0.5 * vol[p] * inertia[p] * speed2;
+      // The stable step of the state left (stable_time_step()'s limit, the same expression).
+      const double c = inertia[p] > 0 ? std::sqrt(wave_modulus_[p] / inertia[p]) : 0.0;
+      const double speed = c + std::sqrt(speed2);
+      limit = std::min(limit, speed > 0 ? h / speed : std::numeric_limits<double>::infinity());
     }
   };
   for_support<Dim>(K, [&](auto support) {
     trapezoidal_ ? update(support, std::true_type{}) : update(support, std::false_type{});
   });
+  step_limit_ = limit;
+  step_limit_valid_ = true;
   // The kinetic energy with the inertia the step used (mass scaling included: that is what must
   // stay small against the work for a scaled run to be quasi-static).
   kinetic_energy_ = kinetic;
@@ -810,6 +868,7 @@ std::vector<PersistentArray> MechanicalPhysics<Dim>::persistent_state() {
 
 template <int Dim>
 void MechanicalPhysics<Dim>::restored() {
+  step_limit_valid_ = false;
   const auto& s = saved_scalars_;
   if (s.size() != 4) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 4");
   primed_ = s[0] != 0;

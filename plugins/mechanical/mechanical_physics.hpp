@@ -122,6 +122,10 @@ class MechanicalPhysics final : public Physics {
 
   // ---- step and counters
   double time_ = 0, dt_ = 0;
+  /// min h / (c_p + |v|) over the particles, taken by map_to_particles from the state it leaves
+  /// (stable_time_step() then needs no pass of its own); invalid until then.
+  double step_limit_ = 0;
+  bool step_limit_valid_ = false;
   bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
   double kinetic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
   std::vector<double> saved_scalars_;
