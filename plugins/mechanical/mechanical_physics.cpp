@@ -3,6 +3,7 @@
 #include "mechanical_physics.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -27,6 +28,70 @@ void for_support(int K, F&& f) {
     f(std::integral_constant<int, gimp>{});
   else
     f(K);
+}
+
+/// update_stress()'s kinematics in plane strain — the strain increment, F ← (I + L Δt) F, the
+/// volume ratio det(I + L Δt) and the Jaumann rotation of the start stress — as the generic
+/// 3×3 arithmetic computes them, bit for bit, without its terms that plane strain makes zero:
+/// an addend ±0 leaves a sum unchanged unless the sum so far is −0, and a sum is −0 only when
+/// both its operands are, so every sum left shorter here starts from a literal +0 or from a
+/// value checked not to be −0. The out-of-plane entries of F must be exactly +0 (and F_zz 1),
+/// as the generic update keeps them in 2-D, and L finite (a non-finite L gives NaNs whose
+/// placement the generic code decides); otherwise it returns false without writing anything,
+/// and the generic code runs. F is row-major 3×3, the stresses 6 Voigt values.
+bool plane_strain_kinematics(const std::array<std::array<double, 2>, 2>& L, double dt, double* F, double* de,
+                             double& J_ratio, bool jaumann, const double* start, double* rotated) {
+  constexpr auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+  constexpr std::uint64_t kMinusZero = std::uint64_t{1} << 63;
+  if (bits(F[2]) != 0 || bits(F[5]) != 0 || bits(F[6]) != 0 || bits(F[7]) != 0 || F[8] != 1.0) return false;
+  if (bits(F[0]) == kMinusZero || bits(F[1]) == kMinusZero || bits(F[3]) == kMinusZero || bits(F[4]) == kMinusZero)
+    return false;
+  const double l00 = L[0][0], l01 = L[0][1], l10 = L[1][0], l11 = L[1][1];
+  if (!(std::isfinite(l00) && std::isfinite(l01) && std::isfinite(l10) && std::isfinite(l11))) return false;
+  const double dl00 = dt * l00, dl01 = dt * l01, dl10 = dt * l10, dl11 = dt * l11;
+  // (I + L Δt): the generic (a == b ? 1 : 0) + Δt l_ab; its out-of-plane entries are +0 and 1.
+  const double i0 = 1.0 + dl00, i1 = 0.0 + dl01, i3 = 0.0 + dl10, i4 = 1.0 + dl11;
+  if (!(std::isfinite(i0) && std::isfinite(i1) && std::isfinite(i3) && std::isfinite(i4))) return false;
+  // Δε = sym(L) Δt in Voigt order; sym_01 = sym_10 (addition commutes).
+  const double sym00 = 0.5 * (l00 + l00) * dt, sym11 = 0.5 * (l11 + l11) * dt, sym01 = 0.5 * (l01 + l10) * dt;
+  const double zero = 0.5 * (0.0 + 0.0) * dt;  // sym_22, sym_12, ... as the generic code makes them
+  de[0] = sym00;
+  de[1] = sym11;
+  de[2] = zero;
+  de[3] = 0.5 * (zero + zero);
+  de[4] = 0.5 * (zero + zero);
+  de[5] = 0.5 * (sym01 + sym01);
+  // F ← (I + L Δt) F: F_ab + Σ_c Δt l_ac F_cb, the c = 2 term (+0 · F_2b, F_2b = +0) left out.
+  const double F00 = F[0], F01 = F[1], F10 = F[3], F11 = F[4];
+  F[0] = (F00 + dl00 * F00) + dl01 * F10;
+  F[1] = (F01 + dl00 * F01) + dl01 * F11;
+  F[3] = (F10 + dl10 * F00) + dl11 * F10;
+  F[4] = (F11 + dl10 * F01) + dl11 * F11;
+  // det(I + L Δt) by the generic cofactor expansion with its +0 entries and the 1 taken out.
+  J_ratio = i0 * i4 - i1 * i3;
+  // Jaumann: σ + Δt (Wσ − σW), W_01 = ½(l_01 − l_10), W_10 = ½(l_10 − l_01), the rest ±0.
+  std::copy(start, start + 6, rotated);
+  if (jaumann) {
+    const double W01 = 0.5 * (l01 - l10), W10 = 0.5 * (l10 - l01);
+    const double S00 = start[0], S11 = start[1], S22 = start[2], S12 = start[3], S02 = start[4], S01 = start[5];
+    const double S10 = S01, S21 = S12, S20 = S02;
+    const double out00 = S00 + dt * ((0.0 + W01 * S10) - (0.0 + S01 * W10));
+    const double out01 = S01 + dt * ((0.0 + W01 * S11) - (0.0 + S00 * W01));
+    const double out02 = S02 + dt * ((0.0 + W01 * S12) - 0.0);
+    const double out10 = S10 + dt * ((0.0 + W10 * S00) - (0.0 + S11 * W10));
+    const double out11 = S11 + dt * ((0.0 + W10 * S01) - (0.0 + S10 * W01));
+    const double out12 = S12 + dt * ((0.0 + W10 * S02) - 0.0);
+    const double out20 = S20 + dt * (0.0 - (0.0 + S21 * W10));
+    const double out21 = S21 + dt * (0.0 - (0.0 + S20 * W01));
+    const double out22 = S22 + dt * (0.0 - 0.0);
+    rotated[0] = out00;
+    rotated[1] = out11;
+    rotated[2] = out22;
+    rotated[3] = 0.5 * (out12 + out21);
+    rotated[4] = 0.5 * (out02 + out20);
+    rotated[5] = 0.5 * (out01 + out10);
+  }
+  return true;
 }
 
 /// The most nodes a particle's support has (cubic B-splines in 3-D): the size of the per-particle
@@ -423,35 +488,46 @@ void MechanicalPhysics<Dim>::update_stress() {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
     const auto L = transfer.vector_gradient_at(p, vn);
-    tensor3::Mat l{}, W{};
-    for (int a = 0; a < Dim; ++a)
-      for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
     double* de = strain_increment_.data() + 6 * p;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
-    tensor3::Mat sym{};
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
-    tensor3::from_matrix(sym, de);
+    double* rotated = rotated_.data() + 6 * p;
     const auto& m = materials_[transfer.material(p)];
     // Thermal strain of the grains: β_s ΔT / 3 on each normal component (β_s is volumetric).
     const double dT = thermal ? T[p] - previous_T_[p] : 0.0;
     const double thermal_strain = m.expansion * dT / 3.0;
-    // Kinematics: F ← (I + L Δt) F, and the solid volume conserved (grains expand with β_s).
-    double f[9];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        double s = F[9 * p + 3 * a + b];
-        for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
-        f[3 * a + b] = s;
-      }
-    double increment[9];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
-    const double J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
-                           increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
-                           increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
-    std::copy(f, f + 9, F.data() + 9 * p);
+    // Kinematics: Δε, F ← (I + L Δt) F, the volume ratio and the rotated start stress.
+    double J_ratio = 0;
+    bool done = false;
+    if constexpr (Dim == 2)
+      done = plane_strain_kinematics(L, dt_, F.data() + 9 * p, de, J_ratio, jaumann_, sigma_start.data() + 6 * p,
+                                     rotated);
+    if (!done) {
+      tensor3::Mat l{}, W{};
+      for (int a = 0; a < Dim; ++a)
+        for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
+      tensor3::Mat sym{};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
+      tensor3::from_matrix(sym, de);
+      double f[9];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          double s = F[9 * p + 3 * a + b];
+          for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
+          f[3 * a + b] = s;
+        }
+      double increment[9];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
+      J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
+                increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
+                increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
+      std::copy(f, f + 9, F.data() + 9 * p);
+      std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
+      if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
+    }
+    // The solid volume conserved (grains expand with β_s).
     const double new_phi = 1.0 - (1.0 - phi[p]) * (1.0 + m.expansion * dT) / J_ratio;
     if (!(new_phi > 0.0 && new_phi < 1.0) || !(J_ratio > 0)) {
 #pragma omp critical
@@ -461,9 +537,6 @@ void MechanicalPhysics<Dim>::update_stress() {
     }
     for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
     for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
-    double* rotated = rotated_.data() + 6 * p;
-    std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
-    if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
     if (thermal) previous_T_[p] = T[p];
     double rho_m, skeleton, n_l;
     density(p, rho_m, skeleton, n_l);
