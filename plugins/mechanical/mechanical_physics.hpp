@@ -122,7 +122,8 @@ class MechanicalPhysics final : public Physics {
   // ---- step and counters
   double time_ = 0, dt_ = 0;
   bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
-  double kinetic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  double kinetic_energy_ = 0, elastic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  static double elastic_energy_density(const double* stress, double p_wave_modulus, double shear_modulus);
   std::vector<double> saved_scalars_;
 
   void read_boundaries(Kernel<Dim>& kernel);
