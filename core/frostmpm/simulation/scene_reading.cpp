@@ -271,10 +271,8 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     const ConfigNode type = item.child("type");
     bc.type = type.as_string();
     if (!bc_owner_.count(bc.type)) {
-      std::string message = "unknown boundary condition type '" + bc.type + "'";
-      const std::string hint = closest_match(bc.type, types);
-      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
-      throw type.error(message + " Types of the physics in this scene: " + join(types));
+      throw type.error("unknown boundary condition type '" + bc.type + "'" + did_you_mean(bc.type, types) +
+                       " Types of the physics in this scene: " + join(types));
     }
     if (auto name = item.optional_child("name")) {
       bc.name = name->as_string();
