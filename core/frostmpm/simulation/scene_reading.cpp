@@ -285,6 +285,9 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     if (on_nodes == on_particles) throw item.error("give exactly one target: 'nodes:' or 'particles:'");
     if (on_nodes) {
       const ConfigNode target = item.child("nodes");
+      target.reject_unknown({"face", "range", "box"});
+      if (target.has("face") == target.has("box"))
+        throw target.error("expected {face: NAME} (with an optional range: [from, to]) or {box: {min, max}}");
       if (auto face = target.optional_child("face")) {
         bool ok = false;
         const GridFace f = GridFace::parse(face->as_string(), kDim, ok);
@@ -317,17 +320,20 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
           bc.node_areas = std::move(areas);
           bc.target_text += " within [" + number_text(r[0]) + ", " + number_text(r[1]) + "] m";
         }
-      } else if (auto box = target.optional_child("box")) {
-        const auto lo = read_point(box->child("min"));
-        const auto hi = read_point(box->child("max"));
-        box->finish({"min", "max"});
+      } else {
+        // A box has its extent already; `range:` would have been ignored.
+        if (auto range = target.optional_child("range"))
+          throw range->error("range: selects part of a face (nodes: {face: ..., range: [from, to]}); a box gives "
+                             "its extent with min: and max:");
+        const ConfigNode box = target.child("box");
+        box.reject_unknown({"min", "max"});
+        const auto lo = read_point(box.child("min"));
+        const auto hi = read_point(box.child("max"));
         bc.nodes = box_nodes<kDim>(grid_, lo, hi);
         bc.node_areas.assign(bc.nodes.size(), 0.0);
         bc.target_text = "node box";
-        if (bc.nodes.empty()) throw box->error("the box contains no grid nodes");
+        if (bc.nodes.empty()) throw box.error("the box contains no grid nodes");
       }
-      target.finish({"face", "box", "range"});
-      if (bc.nodes.empty()) throw target.error("expected {face: NAME} or {box: {min, max}}");
     } else {
       const ConfigNode target = item.child("particles");
       const RegionShape shape = read_region_shape(target);
