@@ -122,6 +122,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
   constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("pore_pressure")) {
+    bc->accept_keys({"value", "hydrostatic"});
     if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
     PressureCondition c;
     c.nodes = bc->nodes;
@@ -131,6 +132,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
     pressure_bcs_.push_back(std::move(c));
   }
   for (auto* bc : sim.boundary_conditions("water_flux")) {
+    bc->accept_keys({"value"});
     const bool face = !bc->on_particles &&
                       std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
     if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");

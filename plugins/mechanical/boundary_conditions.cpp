@@ -29,6 +29,20 @@ constexpr int kPlateOwner = -2;
 
 const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
 
+/// The keys x, y (, z) of a condition given by components.
+template <int Dim>
+std::vector<std::string> axis_keys() {
+  std::vector<std::string> keys;
+  for (int d = 0; d < Dim; ++d) keys.push_back(axis_name(d));
+  return keys;
+}
+
+template <typename T>
+std::vector<T> with(std::vector<T> items, const std::vector<T>& more) {
+  items.insert(items.end(), more.begin(), more.end());
+  return items;
+}
+
 template <int Dim>
 int read_axis(const ConfigNode& node) {
   const std::string c = node.as_string();
@@ -60,12 +74,14 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     velocity_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("fixed")) {
+    bc->accept_keys({});
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     for (int d = 0; d < Dim; ++d) value[d] = TimeFunction::constant(0.0);
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("roller")) {
+    bc->accept_keys({"component"});
     on_nodes(bc);
     int axis = bc->face_axis;
     if (auto component = bc->node->optional_child("component")) axis = read_axis<Dim>(*component);
@@ -75,6 +91,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("velocity")) {
+    bc->accept_keys(axis_keys<Dim>());
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     bool any = false;
@@ -84,11 +101,12 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
         any = true;
       }
     if (!any)
-      throw bc->node->error("a velocity condition prescribes at least one component: x, y" +
-                            std::string(Dim == 3 ? ", z" : "") + " (m/s, a constant, table or expression)");
+      throw bc->node->error("a velocity condition prescribes at least one component: " + join(axis_keys<Dim>()) +
+                            " (m/s, a constant, table or expression)");
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("rigid_plate")) {
+    bc->accept_keys({"force"});
     on_nodes(bc);
     if (bc->face_axis < 0) throw bc->node->error("rigid_plate acts on a grid face: use nodes: {face: ...}");
     PlateCondition c;
@@ -134,13 +152,14 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     traction_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("traction")) {
+    bc->accept_keys(with<std::string>({"normal", "shear"}, axis_keys<Dim>()));
     std::array<TimeFunction, Dim> value;
     bool by_components = false;
     for (int d = 0; d < Dim; ++d) by_components = by_components || bc->node->has(axis_name(d));
     const bool by_normal = bc->node->has("normal") || bc->node->has("shear");
     if (by_components == by_normal)
-      throw bc->node->error("give the traction either as normal: (and in 2-D shear:) or as components x:, y:" +
-                            std::string(Dim == 3 ? ", z:" : "") + " (Pa, tension positive)");
+      throw bc->node->error("give the traction either as normal: (and in 2-D shear:) or as components " +
+                            join(axis_keys<Dim>(), ":, ") + ": (Pa, tension positive)");
     if (by_components) {
       for (int d = 0; d < Dim; ++d)
         if (auto t = bc->node->optional_child(axis_name(d))) value[d] = TimeFunction::read(*t, kMaxTraction, end);
@@ -159,6 +178,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_traction(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("surcharge")) {
+    bc->accept_keys({"value", "normal"});
     int axis = bc->face_axis, side = bc->face_side;
     if (bc->on_particles) {
       axis = particle_normal_axis(*bc);

@@ -126,6 +126,7 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
+    bc->accept_keys({"value"});
     TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
@@ -134,11 +135,13 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
     return !bc->on_particles && std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
+    bc->accept_keys({"value"});
     if (!on_face(bc)) throw bc->node->error("heat_flux acts on a grid face: use nodes: {face: ...}");
     flux_.push_back(
         {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
+    bc->accept_keys({"h", "ambient"});
     if (!on_face(bc)) throw bc->node->error("convective acts on a grid face: use nodes: {face: ...}");
     const ConfigNode h = bc->node->child("h");
     const double coefficient = h.as_real();
