@@ -72,6 +72,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   }
   const auto checkpoint = root.optional_child("checkpoint");
   read_checkpoint(checkpoint ? *checkpoint : ConfigNode(YAML::Node(YAML::NodeType::Map), root.file(), "checkpoint"));
+  initialize_state();
 }
 
 Simulation::~Simulation() = default;
@@ -459,7 +460,7 @@ CheckedFile reopen_metrics(const OutputDir& out, const std::string& header, long
 
 }  // namespace
 
-void Simulation::run(const OutputDir& out, const RunOptions& options) {
+void Simulation::initialize_state() {
   // The stencil is needed by the first probe evaluation; it stays valid until particles move
   // (a physics may key cached grid state to its version).
   update_stencil();
@@ -468,6 +469,10 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   // run, and the checkpoint then overwrites every field and persistent array.
   for (auto& physics : physics_) physics->initialize();
   check_step_budget();
+}
+
+void Simulation::run(const OutputDir& out, const RunOptions& options) {
+  // The constructor built the initial state (initialize_state).
   LoopState loop;
   if (options.restart) {
     loop = restore_checkpoint(out.path());

@@ -59,7 +59,9 @@ enum class LeavingPolicy { Stop, Remove };
 class Simulation final : public Kernel<kDim> {
  public:
   /// Reads and validates every section of a simulation scene (grid, time, gravity, materials,
-  /// physics, regions, boundary_conditions, output, probes). Throws InputError.
+  /// physics, regions, boundary_conditions, output, probes) and builds the initial state the first
+  /// step starts from (stencils, every physics' initialize()), so that `frostmpm check` refuses
+  /// all that `run` would before its first step. Throws InputError.
   Simulation(const Registry& registry, const ConfigNode& root);
   ~Simulation() override;
 
@@ -135,6 +137,8 @@ class Simulation final : public Kernel<kDim> {
 
   // simulation.cpp
   void resolve_step();
+  /// Stencils and every physics' initialize() on the initial state, then the step budget.
+  void initialize_state();
   void bind_handles();
   /// Nodal fields kept between steps, for checkpoints.
   std::vector<PersistentArray> carried_node_fields();
