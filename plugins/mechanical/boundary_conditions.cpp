@@ -9,8 +9,12 @@
 //   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
 //                                                   the total force F [N, per m in 2-D] (Mandel)
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
-// ∂Ω_v) and record the force they exert on the material (reaction probes). A traction acting
-// on a component a velocity condition prescribes is refused: the two would fight.
+// ∂Ω_v) and record the force they exert on the material (reaction probes). Where conditions
+// meet on a node component:
+//  - two velocity conditions must prescribe the same value (a fixed base and side rollers at a
+//    corner, both 0); the first keeps the component and its reaction;
+//  - a traction acting on a component a velocity condition prescribes is refused: the two would
+//    fight.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -24,10 +28,16 @@ namespace {
 constexpr double kMaxVelocity = 1e4;   // m/s
 constexpr double kMaxTraction = 1e10;  // Pa
 
-/// constraint_owner_ value of a node component that a rigid plate moves.
+/// constraint_owner_ value of a node component no condition holds, and of one a rigid plate moves.
+constexpr int kFree = -1;
 constexpr int kPlateOwner = -2;
 
 const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
+
+/// A prescribed velocity as messages give it: "0.1 m/s", "expression: 0.01*t".
+std::string velocity_text(const TimeFunction& f) {
+  return f.describe() + (f.kind() == TimeFunction::Kind::Constant ? " m/s" : "");
+}
 
 /// The keys x, y (, z) of a condition given by components.
 template <int Dim>
@@ -57,20 +67,33 @@ template <int Dim>
 void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
   const double end = kernel.end_time();
   const std::size_t nodes = kernel.grid().node_count();
-  constraint_owner_.assign(nodes * Dim, -1);
+  constraint_owner_.assign(nodes * Dim, kFree);
   auto on_nodes = [](const BoundaryCondition* bc) {
     if (bc->on_particles)
       throw bc->node->error(bc->type + " acts on grid nodes: use nodes: {face: ...} or {box: ...}");
   };
+  // Velocity conditions come before plates and tractions, which check against what they hold.
   auto add_velocity = [&](BoundaryCondition* bc, std::array<std::optional<TimeFunction>, Dim> value) {
+    const int index = static_cast<int>(velocity_bcs_.size());
+    for (std::size_t i : bc->nodes)
+      for (int d = 0; d < Dim; ++d) {
+        if (!value[d]) continue;
+        int& owner = constraint_owner_[i * Dim + d];
+        if (owner == kFree) {
+          owner = index;
+          continue;
+        }
+        const VelocityCondition& other = velocity_bcs_[std::size_t(owner)];
+        if (!other.value[d]->same_values(*value[d]))
+          throw bc->node->error("the " + bc->label() + " prescribes " + axis_name(d) + " = " +
+                                velocity_text(*value[d]) + " on nodes where the " + other.bc->label() +
+                                " prescribes " + velocity_text(*other.value[d]) +
+                                ": a node component follows one value; restrict one condition's nodes");
+      }
     VelocityCondition c;
     c.bc = bc;
     c.nodes = bc->nodes;
     c.value = std::move(value);
-    const int index = static_cast<int>(velocity_bcs_.size());
-    for (std::size_t i : c.nodes)
-      for (int d = 0; d < Dim; ++d)
-        if (c.value[d] && constraint_owner_[i * Dim + d] < 0) constraint_owner_[i * Dim + d] = index;
     velocity_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("fixed")) {
