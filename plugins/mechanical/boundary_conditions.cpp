@@ -13,6 +13,7 @@
 // meet on a node component:
 //  - two velocity conditions must prescribe the same value (a fixed base and side rollers at a
 //    corner, both 0); the first keeps the component and its reaction;
+//  - a rigid plate shares it with nothing (two plates would each carry their load);
 //  - a traction acting on a component a velocity condition prescribes is refused: the two would
 //    fight.
 #include <algorithm>
@@ -28,9 +29,9 @@ namespace {
 constexpr double kMaxVelocity = 1e4;   // m/s
 constexpr double kMaxTraction = 1e10;  // Pa
 
-/// constraint_owner_ value of a node component no condition holds, and of one a rigid plate moves.
+/// constraint_owner_ of a node component no condition holds, and of one rigid plate k moves.
 constexpr int kFree = -1;
-constexpr int kPlateOwner = -2;
+int plate_owner(std::size_t k) { return -2 - static_cast<int>(k); }
 
 const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
 
@@ -68,6 +69,10 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
   const double end = kernel.end_time();
   const std::size_t nodes = kernel.grid().node_count();
   constraint_owner_.assign(nodes * Dim, kFree);
+  // The condition holding a node component (constraint_owner_ ≠ kFree), for messages.
+  auto holder = [&](int owner) {
+    return owner >= 0 ? velocity_bcs_[std::size_t(owner)].bc : plates_[std::size_t(-2 - owner)].bc;
+  };
   auto on_nodes = [](const BoundaryCondition* bc) {
     if (bc->on_particles)
       throw bc->node->error(bc->type + " acts on grid nodes: use nodes: {face: ...} or {box: ...}");
@@ -140,10 +145,14 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     c.load = TimeFunction::read(bc->node->child("force"), 1e12, end);
     for (std::size_t i : c.nodes) {
       int& owner = constraint_owner_[i * Dim + c.axis];
-      if (owner >= 0)
-        throw bc->node->error("the " + bc->label() + " and the " + velocity_bcs_[std::size_t(owner)].bc->label() +
-                              " both prescribe the " + axis_name(c.axis) + " motion of some nodes");
-      owner = kPlateOwner;
+      if (owner != kFree) {
+        const bool two_plates = owner < kFree;
+        throw bc->node->error("the " + bc->label() + " and the " + holder(owner)->label() + " both prescribe the " +
+                              axis_name(c.axis) + " motion of some nodes" +
+                              (two_plates ? ": two plates would each carry their own load; give one the total force"
+                                          : ""));
+      }
+      owner = plate_owner(plates_.size());
     }
     plates_.push_back(std::move(c));
   }
@@ -163,14 +172,10 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     for (int d = 0; d < Dim; ++d) {
       if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
       for (std::size_t i : c.nodes)
-        if (constraint_owner_[i * Dim + d] >= 0 || constraint_owner_[i * Dim + d] == kPlateOwner) {
-          const auto* other = constraint_owner_[i * Dim + d] == kPlateOwner
-                                  ? plates_.front().bc
-                                  : velocity_bcs_[std::size_t(constraint_owner_[i * Dim + d])].bc;
+        if (const int owner = constraint_owner_[i * Dim + d]; owner != kFree)
           throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component of nodes that the " +
-                                other->label() + " prescribes: a velocity condition and a traction cannot both act on "
-                                "one component");
-        }
+                                holder(owner)->label() + " prescribes: a velocity condition and a traction cannot both "
+                                "act on one component");
     }
     traction_bcs_.push_back(std::move(c));
   };
