@@ -14,8 +14,10 @@
 //  - two velocity conditions must prescribe the same value (a fixed base and side rollers at a
 //    corner, both 0); the first keeps the component and its reaction;
 //  - a rigid plate shares it with nothing (two plates would each carry their load);
-//  - a traction acting on a component a velocity condition prescribes is refused: the two would
-//    fight.
+//  - a traction may load some held nodes (a side load reaching the fixed base's corner): the held
+//    value wins there and the traction's share goes into that condition's reaction, so no force
+//    is lost; a traction all of whose loaded nodes are held on that component is refused, since
+//    it could never act.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -171,11 +173,22 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     c.areas = bc->node_areas;
     for (int d = 0; d < Dim; ++d) {
       if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
-      for (std::size_t i : c.nodes)
-        if (const int owner = constraint_owner_[i * Dim + d]; owner != kFree)
-          throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component of nodes that the " +
-                                holder(owner)->label() + " prescribes: a velocity condition and a traction cannot both "
-                                "act on one component");
+      // Held nodes are fine as long as one node it loads is free to move (see the top of this file).
+      std::vector<std::string> holders;
+      bool acts = false;
+      for (std::size_t j = 0; j < c.nodes.size() && !acts; ++j) {
+        if (c.areas[j] <= 0) continue;
+        const int owner = constraint_owner_[c.nodes[j] * Dim + d];
+        if (owner == kFree) acts = true;
+        else if (const std::string label = holder(owner)->label();
+                 std::find(holders.begin(), holders.end(), label) == holders.end())
+          holders.push_back(label);
+      }
+      if (!acts && !holders.empty())
+        throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component only of nodes the " +
+                              join(holders, " and the ") + (holders.size() > 1 ? " hold" : " holds") +
+                              ", so it could never act: a velocity condition and a traction fight on that component "
+                              "(a rigid plate's load belongs in its force:)");
     }
     traction_bcs_.push_back(std::move(c));
   };

@@ -1,5 +1,6 @@
 // Scenes that combine conditions in ways the bad-input corpus cannot show, since they are
-// accepted: velocity conditions that agree where they meet.
+// accepted: velocity conditions that agree where they meet, and a side load reaching the fixed
+// base's corner (its force still balanced by the reactions).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -31,4 +32,30 @@ TEST_CASE("velocity conditions that prescribe the same value where they meet are
   succeeds(column + " --set 'boundary_conditions.2={type: velocity, nodes: {face: x_max}, x: 0}'");
   succeeds(column +
            " --set 'boundary_conditions.2={type: velocity, nodes: {face: x_max}, x: {table: [[0, 0], [1, 0]]}}'");
+}
+
+TEST_CASE("a traction on a whole side reaching held corners is accepted, and the reactions balance it",
+          "[mechanical][boundary]") {
+  // Mandel's top face loaded by a traction with shear, the left rollers holding its corner's x.
+  succeeds("check " + scene("verification/mandel") +
+           " --set 'boundary_conditions.2={type: traction, nodes: {face: y_max}, normal: -1000, shear: 100}'"
+           " --set 'probes.2={name: s, type: settlement}'");
+
+  // The self-weight column pushed sideways over its whole right face (1 m × 1 kPa): the fixed
+  // base holds the bottom corner, so it takes that node's share, and with the left rollers it
+  // balances the whole load once the damped column is at rest.
+  TempDir dir;
+  succeeds("run -q " + scene("verification/self_weight_column") + " -o " + dir.file("out") +
+           " --set 'boundary_conditions.1={type: roller, nodes: {face: x_min}, name: wall}'"
+           " --set 'boundary_conditions.2={type: traction, nodes: {face: x_max}, normal: -1000, name: side}'"
+           " --set 'probes=[{name: wall, type: reaction, boundary: wall, component: x},"
+           " {name: base, type: reaction, boundary: base, component: x},"
+           " {name: side, type: reaction, boundary: side, component: x}]'");
+  const auto metrics = read_csv(dir.file("out/metrics.csv"));
+  const auto& last = metrics.rows.back();
+  const double wall = last[metrics.column("wall")], base = last[metrics.column("base")],
+               side = last[metrics.column("side")];
+  CHECK(side == Approx(-1000).epsilon(1e-12));
+  CHECK(base != 0);  // the corner's share of the load
+  CHECK(std::abs(wall + base + side) < 1e-3 * 1000);
 }
