@@ -162,10 +162,22 @@ void Probes::read(const ConfigNode* node, Sources sources) {
     } else if (probe->type == "reaction") {
       const ConfigNode boundary = item.child("boundary");
       probe->boundary = boundary.as_string();
-      const auto& names = sources_.boundary_names;
-      if (std::find(names.begin(), names.end(), probe->boundary) == names.end())
+      const auto& named = sources_.boundaries;
+      const auto it = std::find_if(named.begin(), named.end(),
+                                   [&](const NamedBoundary& b) { return b.name == probe->boundary; });
+      if (it == named.end()) {
+        std::vector<std::string> names;
+        for (const auto& b : named) names.push_back(b.name);
         throw boundary.error("no boundary condition is named '" + probe->boundary + "'; named: " +
                              (names.empty() ? std::string("none (give one a name: key)") : join(names)));
+      }
+      // Its value would be NaN all run.
+      if (!it->has_reaction) {
+        const auto& types = sources_.reaction_types;
+        throw boundary.error("the " + it->label + " reports no reaction force; of this scene's conditions, " +
+                             (types.empty() ? std::string("none does")
+                                            : "those of type " + join(types, ", ") + " do"));
+      }
       probe->component = read_component(item.child("component"), kDim);
       item.finish({"type", "name", "boundary", "component"});
     } else {

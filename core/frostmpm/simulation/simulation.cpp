@@ -63,8 +63,13 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
     sources.grid = &grid_;
     sources.particles = &particles_;
     sources.transfer = &transfer_;
-    for (const auto& bc : bcs_)
-      if (!bc.name.empty()) sources.boundary_names.push_back(bc.name);
+    for (const auto& bc : bcs_) {
+      const bool has_reaction = reaction_of(bc).has_value();
+      if (has_reaction && std::find(sources.reaction_types.begin(), sources.reaction_types.end(), bc.type) ==
+                              sources.reaction_types.end())
+        sources.reaction_types.push_back(bc.type);
+      if (!bc.name.empty()) sources.boundaries.push_back({bc.name, bc.label(), has_reaction});
+    }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
     const auto probes = root.optional_child("probes");
     probes_.read(probes ? &*probes : nullptr, std::move(sources));
@@ -123,14 +128,17 @@ std::string Simulation::describe_particle(std::size_t p) const {
   return out.str();
 }
 
+std::optional<std::array<double, 3>> Simulation::reaction_of(const BoundaryCondition& bc) const {
+  const std::string& owner = bc_owner_.at(bc.type);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    if (physics_keys_[i] == owner) return physics_[i]->reaction(bc);
+  return std::nullopt;
+}
+
 std::array<double, 3> Simulation::reaction(const std::string& name) const {
-  for (const auto& bc : bcs_) {
-    if (bc.name != name) continue;
-    const std::string& owner = bc_owner_.at(bc.type);
-    for (std::size_t i = 0; i < physics_.size(); ++i)
-      if (physics_keys_[i] == owner)
-        if (const auto force = physics_[i]->reaction(bc)) return *force;
-  }
+  for (const auto& bc : bcs_)
+    if (bc.name == name)
+      if (const auto force = reaction_of(bc)) return *force;
   return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
           std::numeric_limits<double>::quiet_NaN()};
 }

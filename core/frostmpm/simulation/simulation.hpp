@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -156,7 +157,9 @@ class Simulation final : public Kernel<kDim> {
   void save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene);
   /// Kernel state, particle fields and persistent arrays from <dir>/checkpoint.h5.
   LoopState restore_checkpoint(const std::string& dir);
-  /// The reaction force on the boundary condition named `name`, from the physics owning it.
+  /// The force `bc` exerts on the material, from the physics owning it; none when it does not track it.
+  std::optional<std::array<double, 3>> reaction_of(const BoundaryCondition& bc) const;
+  /// The reaction force on the boundary condition named `name` (probes name only those that have one).
   std::array<double, 3> reaction(const std::string& name) const;
 
   const Registry& registry_;
