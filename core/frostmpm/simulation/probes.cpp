@@ -105,6 +105,13 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       throw type.error("unknown probe type '" + probe->type + "'; valid: " + join(types));
     const ConfigNode name = item.child("name");
     probe->name = name.as_string();
+    const auto& reserved = leading_columns();
+    if (std::find(reserved.begin(), reserved.end(), probe->name) != reserved.end())
+      throw name.error("'" + probe->name + "' is a column metrics.csv always has (" + join(reserved) +
+                       "); give the probe another name");
+    if (probe->name.empty() || probe->name.find_first_of(",\n\r\"") != std::string::npos)
+      throw name.error("a probe name is a metrics.csv column header: not empty, and without commas, quotes or "
+                       "line breaks");
     if (const auto [it, fresh] = first_use.emplace(probe->name, name.where()); !fresh)
       throw name.error("probe name '" + probe->name + "' is used twice (first at " + it->second.describe() +
                        "); metrics.csv needs one column per name");
@@ -199,8 +206,13 @@ void Probes::read(const ConfigNode* node, Sources sources) {
   }
 }
 
+const std::vector<std::string>& Probes::leading_columns() {
+  static const std::vector<std::string> columns = {"time_s", "step", "dt_s"};
+  return columns;
+}
+
 std::string Probes::header() const {
-  std::string header = "time_s,step,dt_s";
+  std::string header = join(leading_columns(), ",");
   for (const auto& probe : probes_) header += ',' + probe->name;
   return header;
 }

@@ -57,6 +57,8 @@ class Probes {
   std::vector<double> evaluate() const;
   /// "time_s,step,dt_s,<probe names>".
   std::string header() const;
+  /// The columns metrics.csv has before the probes' (no probe may take these names).
+  static const std::vector<std::string>& leading_columns();
   YAML::Node resolved() const { return resolved_; }
 
   /// A particle field (or one component, "stress.yy", "water_flux.x") interpolated to a point
