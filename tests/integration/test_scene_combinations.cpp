@@ -1,6 +1,6 @@
-// Scenes that combine conditions in ways the bad-input corpus cannot show, since they are
-// accepted: velocity conditions that agree where they meet, and a side load reaching the fixed
-// base's corner (its force still balanced by the reactions).
+// Scenes that combine conditions and values in ways the bad-input corpus cannot show, since they
+// are accepted: velocity conditions that agree where they meet, a side load reaching the fixed
+// base's corner (its force still balanced by the reactions), and initial vectors given as lists.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -58,4 +58,17 @@ TEST_CASE("a traction on a whole side reaching held corners is accepted, and the
   CHECK(side == Approx(-1000).epsilon(1e-12));
   CHECK(base != 0);  // the corner's share of the load
   CHECK(std::abs(wall + base + side) < 1e-3 * 1000);
+}
+
+TEST_CASE("an initial vector may be a list of its components", "[mechanical][cli]") {
+  TempDir dir;
+  succeeds("run -q " + scene("verification/vibrating_bar") + " -o " + dir.file("out") +
+           " --set time.end=0.01 --set 'regions.0.initial={solid_velocity: [0.1, {expression: \"0.002*x\"}]}'"
+           " --set 'probes=[{name: vx_min, type: min, field: solid_velocity.x},"
+           " {name: vx_max, type: max, field: solid_velocity.x}, {name: vy_max, type: max, field: solid_velocity.y}]'");
+  const auto metrics = read_csv(dir.file("out/metrics.csv"));
+  const auto& start = metrics.rows.front();  // t = 0, before the first step
+  CHECK(start[metrics.column("vx_min")] == 0.1);
+  CHECK(start[metrics.column("vx_max")] == 0.1);
+  CHECK(start[metrics.column("vy_max")] == Approx(0.002 * 24.75));  // the last particle centre, x = 24.75 m
 }

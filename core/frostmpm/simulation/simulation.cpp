@@ -215,22 +215,31 @@ void Simulation::apply_initial_values() {
         count = particles_.components(field);
       }
       const ParamSpec* spec = material_schema_.find(field);
-      auto check = [&](double value, const std::string& where) {
+      // What is wrong with a value ("is not a finite number"), empty when it is fine.
+      auto problem = [&](double value) -> std::string {
+        if (!std::isfinite(value)) return "is not a finite number";
         // A material parameter set per region obeys the material's range (porosity in (0, 1)).
-        if (!std::isfinite(value))
-          throw entry.error(where + "is not a finite number");
         if (spec && !spec->in_range(value))
-          throw entry.error(where + number_text(value) + " is outside the range of material parameter '" + field +
-                            "'; valid: " + spec->range_text());
+          return "is outside the range of material parameter '" + field + "'; valid: " + spec->range_text();
         if (std::abs(value) > state_bounds_.at(field))
-          throw entry.error(where + number_text(value) + " is beyond the plausible magnitude " +
-                            number_text(state_bounds_.at(field)) + " of '" + field + "'");
+          return "is beyond the plausible magnitude " + number_text(state_bounds_.at(field)) + " of '" + field + "'";
+        return {};
       };
       auto column = particles_.field(field);
       const int c = particles_.components(field);
-      if (entry.is_map()) {
-        const ConfigNode text = entry.child("expression");
-        entry.finish({"expression"});
+      // One value, a number or {expression: ...} of x and y, into components [k, k + n) of the
+      // region's particles.
+      auto assign = [&](const ConfigNode& value_node, int k, int n) {
+        if (!value_node.is_map()) {
+          const double value = value_node.as_real();
+          if (const auto why = problem(value); !why.empty())
+            throw value_node.error("the value " + number_text(value) + " " + why);
+          for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+            std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          return;
+        }
+        const ConfigNode text = value_node.child("expression");
+        value_node.finish({"expression"});
         Expression f;
         try {
           f = Expression::compile(text.as_string(), {"x", "y"});
@@ -240,18 +249,24 @@ void Simulation::apply_initial_values() {
         for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
           const double at[2] = {pos[p * kDim], pos[p * kDim + 1]};
           const double value = f.evaluate(at);
-          if (!std::isfinite(value) || (spec && !spec->in_range(value)) || std::abs(value) > state_bounds_.at(field)) {
-            std::ostringstream where;
-            where << "at (" << at[0] << ", " << at[1] << ") the expression gives ";
-            check(value, where.str());
-          }
-          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+          if (const auto why = problem(value); !why.empty())
+            throw value_node.error("at (" + number_text(at[0], 6) + ", " + number_text(at[1], 6) +
+                                   ") the expression's value " + number_text(value) + " " + why);
+          std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
         }
+      };
+      if (entry.is_sequence()) {
+        // One value per component, in the order of their names: solid_velocity: [0.1, 0] (x, y).
+        const auto parts = component_names(particles_.kind(field), c);
+        const auto values = entry.elements();
+        if (count == 1)
+          throw entry.error("'" + key + "' is one number: give a number or {expression: ...}, not a list");
+        if (values.size() != std::size_t(count))
+          throw entry.error("expected one value for every component of '" + field + "' (" + join(parts) + "), got " +
+                            std::to_string(values.size()) + "; or one value for all");
+        for (int k = 0; k < count; ++k) assign(values[std::size_t(k)], first + k, 1);
       } else {
-        const double value = entry.as_real();
-        check(value, "");
-        for (std::size_t p = init.range.begin; p < init.range.end; ++p)
-          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+        assign(entry, first, count);
       }
     }
   }
