@@ -150,7 +150,8 @@ std::vector<double> HydraulicPhysics::boundary_pressures(const PressureCondition
     if (std::isfinite(p[j])) continue;
     std::ostringstream msg;
     msg << "numerical blow-up: pore pressure boundary value " << p[j] << " from the " << c.label << " (x = " << x[0]
-        << ", y = " << x[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
+        << ", y = " << x[1] << ") at t = " << t << " s, step " << kernel_->step() << " (dt = " << kernel_->dt()
+        << " s); check the value's table or expression";
     throw NumericalBlowUp(msg.str());
   }
   return p;

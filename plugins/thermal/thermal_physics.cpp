@@ -157,7 +157,8 @@ double ThermalPhysics::value_at(const TimeFunction& f, const std::string& label,
   if (std::isfinite(v)) return v;
   std::ostringstream msg;
   msg << "numerical blow-up: temperature boundary value " << v << " from the " << label << " (x = " << place[0]
-      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
+      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << " (dt = " << kernel_->dt()
+      << " s); check the value's table or expression";
   throw NumericalBlowUp(msg.str());
 }
 

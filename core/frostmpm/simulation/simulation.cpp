@@ -277,10 +277,12 @@ void Simulation::apply_initial_values() {
 void Simulation::update_stencil() {
   const long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
   if (outside < 0) return;
+  const auto p = static_cast<std::size_t>(outside);
   std::ostringstream msg;
-  msg << "numerical blow-up: " << describe_particle(static_cast<std::size_t>(outside))
+  msg << "numerical blow-up: " << describe_particle(p)
       << " has left the grid (its shape-function support reaches past the grid's edge) at t = " << time_
-      << " s, step " << step_ << "; enlarge the grid, or check the loads and boundary conditions that drive it";
+      << " s, step " << step_ << " (dt = " << dt_ << " s); enlarge the grid, or the loads drive it too far"
+      << suspects(p);
   throw NumericalBlowUp(msg.str());
 }
 
@@ -313,7 +315,6 @@ void Simulation::update_geometry() {
 }
 
 void Simulation::advance(double dt) {
-  dt_ = dt;
   auto timed = [&](const std::string& name, const std::function<void()>& fn) {
     const auto start = Clock::now();
     fn();
@@ -326,6 +327,7 @@ void Simulation::advance(double dt) {
     });
     positions_changed_ = false;
   }
+  dt_ = dt;  // after the stencil: a particle that left the grid is reported with the step that moved it
   particles_.begin_step();
   for (auto& physics : physics_) physics->begin_step(time_, dt);
   for (auto& stage : plan_.stages()) timed(stage.name, stage.run);
