@@ -107,8 +107,8 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
           throw m.params.error("water_density", "a hydrostatic pore_pressure boundary (" + bc.label +
                                                     ") needs one water density in every material");
   if (!compressible && pressure_bcs_.empty())
-    throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
-                     "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
+    throw params_.section_error("with incompressible water (water_compressibility: 0 in every material) the "
+                                "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
   const std::size_t n = sim.particle_count(), nodes = sim.grid().node_count();
   for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,

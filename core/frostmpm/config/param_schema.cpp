@@ -251,6 +251,7 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
   valid.insert(valid.end(), also_allowed.begin(), also_allowed.end());
   node.reject_unknown(valid);
   ParamSet set;
+  set.set_section(node.where());
   for (const auto& spec : schema.params()) {
     if (node.has(spec.name)) {
       const ConfigNode value = node.child(spec.name);
