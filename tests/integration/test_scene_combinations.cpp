@@ -1,6 +1,7 @@
 // Scenes that combine conditions and values in ways the bad-input corpus cannot show, since they
 // are accepted: velocity conditions that agree where they meet, a side load reaching the fixed
-// base's corner (its force still balanced by the reactions), and initial vectors given as lists.
+// base's corner (its force still balanced by the reactions), initial vectors given as lists, and
+// keys without effect in a scene, which are warned about rather than refused.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -71,4 +72,14 @@ TEST_CASE("an initial vector may be a list of its components", "[mechanical][cli
   CHECK(start[metrics.column("vx_min")] == 0.1);
   CHECK(start[metrics.column("vx_max")] == 0.1);
   CHECK(start[metrics.column("vy_max")] == Approx(0.002 * 24.75));  // the last particle centre, x = 24.75 m
+}
+
+TEST_CASE("gravity and mass scaling in a scene without a momentum balance are warned about", "[cli]") {
+  const std::string output = succeeds("check " + scene("tutorials/frozen_inclusion") +
+                                      " --set 'gravity=[0, -9.81]' --set time.mass_scaling=100");
+  CHECK(output.find("warning: --set gravity=[0, -9.81]: at 'gravity': has no effect") != std::string::npos);
+  CHECK(output.find("warning: --set time.mass_scaling=100: at 'time.mass_scaling': has no effect") != std::string::npos);
+  // Where a physics solves for momentum they act: no warning.
+  CHECK(succeeds("check " + scene("verification/self_weight_column") + " --set time.mass_scaling=100")
+            .find("warning") == std::string::npos);
 }

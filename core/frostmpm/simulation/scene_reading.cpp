@@ -102,6 +102,7 @@ void Simulation::read_gravity(const ConfigNode* node) {
     resolved_["gravity"] = std::vector<double>(kDim, 0.0);
     return;
   }
+  gravity_where_ = node->where();
   const auto g = node->as_reals();
   if (g.size() != kDim)
     throw node->error("gravity is a vector of " + std::to_string(kDim) + " components in m/s^2, e.g. [0, -9.81]");

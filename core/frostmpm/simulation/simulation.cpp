@@ -56,6 +56,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   for (auto& physics : physics_) physics->setup(*this);
   for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
   resolve_step();
+  warn_unused_keys();
   apply_initial_values();
   read_output(root.child("output"));
   {
@@ -165,6 +166,20 @@ void Simulation::resolve_step() {
     std::copy(half.begin(), half.end(), half0.begin());
   }
   bind_handles();
+}
+
+void Simulation::warn_unused_keys() const {
+  // Weight and inertia enter momentum balances only: without a stage predicting momentum, gravity
+  // and mass scaling change nothing, which the user should know rather than believe otherwise.
+  const auto& stages = plan_.stages();
+  if (std::any_of(stages.begin(), stages.end(), [](const Stage& s) { return s.phase == Phase::PredictMomentum; }))
+    return;
+  const std::string why = "has no effect: no physics of this scene solves a momentum balance (no stage in "
+                          "phase predict_momentum)";
+  if (gravity_where_ && std::any_of(gravity_.begin(), gravity_.end(), [](double g) { return g != 0; }))
+    log::warning(gravity_where_->describe() + ": " + why);
+  if (time_params_.real("mass_scaling") != 1.0)
+    log::warning(time_params_.where("mass_scaling").describe() + ": " + why);
 }
 
 void Simulation::bind_handles() {

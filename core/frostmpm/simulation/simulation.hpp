@@ -140,6 +140,8 @@ class Simulation final : public Kernel<kDim> {
   void resolve_step();
   /// Stencils and every physics' initialize() on the initial state, then the step budget.
   void initialize_state();
+  /// Warns about scene keys no physics of the scene uses (gravity without a momentum balance).
+  void warn_unused_keys() const;
   void bind_handles();
   /// Nodal fields kept between steps, for checkpoints.
   std::vector<PersistentArray> carried_node_fields();
@@ -169,6 +171,7 @@ class Simulation final : public Kernel<kDim> {
   Transfer<kDim> transfer_;
   ParticleStore particles_;
   std::array<double, kDim> gravity_{};
+  std::optional<SourceLocation> gravity_where_;  ///< where the scene gave `gravity:`, for warnings
   std::vector<Material> materials_;
   std::vector<BoundaryCondition> bcs_;
   std::vector<std::shared_ptr<Physics>> physics_;
