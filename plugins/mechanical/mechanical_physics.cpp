@@ -415,7 +415,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     std::ostringstream msg;
     msg << "numerical blow-up: the skeleton at " << kernel_->describe_particle(std::size_t(invalid))
         << " was compressed or stretched beyond its solid volume (porosity would leave (0, 1)) at t = " << time_
-        << " s, step " << kernel_->step() << "; the step may be too large or the loads too high";
+        << " s, step " << kernel_->step() << " (dt = " << dt_ << " s); the step may be too large or the loads too high";
     throw NumericalBlowUp(msg.str());
   }
 
@@ -474,8 +474,8 @@ void MechanicalPhysics<Dim>::report_failure(std::size_t p) const {
   const auto& m = materials_[kernel_->transfer().material(p)];
   std::ostringstream msg;
   msg << "numerical blow-up: mechanical model '" << m.model_name << "' could not integrate the stress at "
-      << kernel_->describe_particle(p) << " at t = " << time_ << " s, step " << kernel_->step()
-      << "; a smaller time step or other model parameters may help";
+      << kernel_->describe_particle(p) << " at t = " << time_ << " s, step " << kernel_->step() << " (dt = " << dt_
+      << " s); a smaller time step or other model parameters may help";
   throw NumericalBlowUp(msg.str());
 }
 

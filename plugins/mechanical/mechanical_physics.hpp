@@ -103,7 +103,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;
   std::vector<PlateCondition> plates_;
-  std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition, or −1
+  std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition k ≥ 0, −1 free, −2 − k rigid plate k
 
   // ---- fields (bound by the kernel once the step is resolved)
   FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,

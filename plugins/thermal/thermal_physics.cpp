@@ -126,6 +126,7 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
+    bc->accept_keys({"value"});
     TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
@@ -147,11 +148,13 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
       throw bc->node->error(bc->type + " acts on a grid face or on particles: use nodes: {face: ...} or particles: SHAPE with area:");
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
+    bc->accept_keys({"value", "area"});
     surface(bc, flux_);
     flux_.push_back(
         {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
+    bc->accept_keys({"h", "ambient", "area"});
     surface(bc, convective_);
     const ConfigNode h = bc->node->child("h");
     const double coefficient = h.as_real();
@@ -193,7 +196,8 @@ double ThermalPhysics::value_at(const TimeFunction& f, const std::string& label,
   if (std::isfinite(v)) return v;
   std::ostringstream msg;
   msg << "numerical blow-up: temperature boundary value " << v << " from the " << label << " (x = " << place[0]
-      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
+      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << " (dt = " << kernel_->dt()
+      << " s); check the value's table or expression";
   throw NumericalBlowUp(msg.str());
 }
 

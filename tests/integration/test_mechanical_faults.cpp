@@ -1,5 +1,5 @@
 // Mechanical runs that fail or are stopped, as a user meets them: a scene that blows up exits 3
-// with one line naming the particle, its region and the time, and keeps the frames written
+// with one line naming the particle, its region, the time and the step size, and keeps the frames written
 // before it readable; a mechanical and a coupled mechanical + hydraulic run stopped with SIGTERM
 // continue with `frostmpm run --restart OUT` to the fields and metrics of an uninterrupted run,
 // bit for bit.
@@ -84,7 +84,7 @@ std::pair<int, double> read_every_frame(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region and the time, earlier frames readable",
+TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region, the time and dt, earlier frames readable",
           "[mechanical][blow-up]") {
   TempDir dir;
   const std::vector<BlowUp> cases = {
@@ -104,6 +104,8 @@ TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region and the 
       CHECK(r.output.find("in regions.0 (material '") != std::string::npos);
       const double when = blow_up_time(r.output);
       REQUIRE(when > 0);
+      CHECK(r.output.find(" s, step ") != std::string::npos);
+      CHECK(r.output.find(" (dt = ") != std::string::npos);
       CHECK(!fs::exists(out + "/run.json"));  // a run that blew up did not finish
 
       // Frames before the blow-up, complete: h5py reads every dataset, the XDMF lists each.
