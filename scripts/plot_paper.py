@@ -8,7 +8,7 @@
     /usr/bin/python3 scripts/plot_paper.py mn OUT_R0.5 OUT_R1.5 [more pairs at other cell sizes] [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
-left), with the 13 INTERFROST codes' thaw-time ranges shaded (VERIFICATION §3).
+left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
 talik: temperature at the centre point A and the equivalent hydraulic conductivity k_eq(t)
 (Fig. 10, right). contours: temperature contours of one frame of fields.h5 with the 0 °C isotherm
 (Figs. 3 and 7); the last frame unless --frame. thaw: the thaw consolidation of Sec. 5.2.1

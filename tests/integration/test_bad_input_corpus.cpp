@@ -1,4 +1,4 @@
-// Every bad input refused (issue #10 §2): each case of tests/corpus/bad_input.txt, a shipped
+// Every bad input refused: each case of tests/corpus/bad_input.txt, a shipped
 // scene broken one way, must exit 2 with one `error:` line naming the file and the YAML path.
 #include <catch2/catch.hpp>
 

@@ -1,6 +1,6 @@
 // Expression (expression.hpp) on muparser: our functions and constants, one parser per thread,
 // muparser's errors turned into ExpressionError with a 1-based column. The home-made compiler
-// this replaced is gone (issue #10).
+// this replaced is gone.
 #include "frostmpm/scene/expression.hpp"
 
 #include <algorithm>
