@@ -129,57 +129,6 @@ TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region, the tim
 
 namespace {
 
-/// `frostmpm ARGS` in the background with default signal dispositions, its output into a file.
-class BackgroundRun {
- public:
-  BackgroundRun(const std::string& args, const std::string& output_path) : output_path_(output_path) {
-    std::string command = "exec " + frostmpm_exe() + " " + args + " >'" + output_path + "' 2>&1";
-    char sh[] = "sh", dash_c[] = "-c";
-    char* argv[] = {sh, dash_c, command.data(), nullptr};
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    sigset_t signals;
-    sigemptyset(&signals);
-    posix_spawnattr_setsigmask(&attributes, &signals);
-    sigaddset(&signals, SIGTERM);
-    posix_spawnattr_setsigdefault(&attributes, &signals);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-    const int status = posix_spawn(&pid_, "/bin/sh", nullptr, &attributes, argv, environ);
-    posix_spawnattr_destroy(&attributes);
-    if (status != 0) throw std::runtime_error("posix_spawn failed");
-  }
-  ~BackgroundRun() {
-    if (!exit_code_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  BackgroundRun(const BackgroundRun&) = delete;
-  BackgroundRun& operator=(const BackgroundRun&) = delete;
-
-  bool running() {
-    if (exit_code_) return false;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return false;
-  }
-  void signal(int number) const { kill(pid_, number); }
-  int wait(double seconds = 300) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (running()) {
-      if (std::chrono::steady_clock::now() > deadline) FAIL("frostmpm did not exit within " << seconds << " s");
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return *exit_code_;
-  }
-  std::string output() const { return read_file(output_path_); }
-
- private:
-  pid_t pid_ = -1;
-  std::optional<int> exit_code_;
-  std::string output_path_;
-};
 
 /// Time of the last complete row of OUT/metrics.csv while a run writes it (-1 before the first).
 double metrics_time(const std::string& out) {
