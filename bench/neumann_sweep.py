@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Work-precision sweep of the two-phase Neumann thaw (VERIFICATION.md §1.1).
+"""Work-precision sweep of the two-phase Neumann thaw (Kurylyk et al. 2014).
 
     /usr/bin/python3 bench/neumann_sweep.py [--quick] [--out DIR] [--budget S] [--reuse]
 
@@ -45,7 +45,7 @@ SCENE = "configs/verification/neumann_thaw.yaml"
 LENGTH = 1.5          # column length [m]; surface at y = LENGTH
 T_END = 86400.0       # 1 d, the scene's time.end
 
-# ---- analytic two-phase Neumann solution (VERIFICATION.md §1.1) -------------------------------
+# ---- analytic two-phase Neumann solution (Kurylyk et al. 2014) -------------------------------
 K_THAWED, K_FROZEN = 1.839, 2.619            # W/m/K
 C_THAWED, C_FROZEN = 3.20225e6, 2.169e6      # J/m³/K
 L_V = 1.67e8                                 # J/m³ (0.5 · 1000 · 334000)
@@ -81,7 +81,7 @@ def temperature(x, t):
 
 
 def check_reference():
-    """The published profile at 1 d (VERIFICATION.md §1.1) to its printed 4 decimals."""
+    """The published profile at 1 d (Kurylyk et al. 2014) to its printed 4 decimals."""
     published = {0.02: 3.7925, 0.05: 1.9919, 0.08: 0.2182, 0.10: -0.1629, 0.20: -1.1295,
                  0.30: -2.0082, 0.50: -3.3986}
     for x, value in published.items():

@@ -78,7 +78,7 @@ def main():
           "Temperature profile vs two-phase Neumann solution")
     panel(axes[1], rows, lambda r: max(abs(r["front_error_m"]), 1e-6), "|front error| at 1 d [m]",
           "Thaw front (S_l = ½) vs X(1 d) = 2λ√(α_thawed t)")
-    fig.suptitle("Neumann thaw (VERIFICATION.md §1.1): error against wall time (larger marker = finer Δx)",
+    fig.suptitle("Neumann thaw (Kurylyk et al. 2014): error against wall time (larger marker = finer Δx)",
                  fontsize=11)
     fig.savefig(sys.argv[2], dpi=130)
     print(f"wrote {sys.argv[2]}")

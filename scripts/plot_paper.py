@@ -6,9 +6,11 @@
     /usr/bin/python3 scripts/plot_paper.py contours OUT [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py thaw OUT_A OUT_B OUT_C OUT_D [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py mn OUT_R0.5 OUT_R1.5 [more pairs at other cell sizes] [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py rock OUT [OUT_beta0 OUT_beta4.5e-5] [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py stabilization OUT_tau0 OUT_tau0.1 OUT_tau0.5 OUT_tau1 [--png FILE] [--frame N]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
-left), with the 13 INTERFROST codes' thaw-time ranges shaded (VERIFICATION §3).
+left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
 talik: temperature at the centre point A and the equivalent hydraulic conductivity k_eq(t)
 (Fig. 10, right). contours: temperature contours of one frame of fields.h5 with the 0 °C isotherm
 (Figs. 3 and 7); the last frame unless --frame. thaw: the thaw consolidation of Sec. 5.2.1
@@ -16,7 +18,12 @@ talik: temperature at the centre point A and the equivalent hydraulic conductivi
 the Neumann estimate and q H/E_oed (Fig. 12B), pore pressure against depth (Fig. 13A) and, for
 Test A at 1 h, p/q, S_c and k0/k (Fig. 13B); it writes FILE and FILE with _profiles before the
 extension. mn: settlement and excess pore pressure of configs/verification/thaw_consolidation_mn.yaml
-against Morgenstern & Nixon's closed form. Each OUT is a run folder (metrics.csv, fields.h5).
+against Morgenstern & Nixon's closed form. rock: the rock freezing of Sec. 5.2.2
+(configs/paper/rock_freezing.yaml): temperature and radial strain at A and B against time, one
+line per run (Fig. 17; the β_s variants by --set), contours of T, S_c, the radial displacement
+and p_l at 5, 10 and 15 h (Figs. 15–16, into FILE with _contours), and p_l, S_l and k along the
+x axis (Fig. 18, _profiles). stabilization: the pore pressure of runs with τ = 0, 0.1, 0.5, 1
+(App. C) at one frame (the last unless --frame). Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -218,10 +225,96 @@ def mn(folders, png):
     frostplot.save(fig, png)
 
 
+# ---- rock freezing (Sec. 5.2.2) ---------------------------------------------------------------
+
+ROCK_HOLE = 0.023  # hole radius [m]; A and B lie 1 and 4 cm from its wall on the x axis
+
+
+def rock_label(folder):
+    scene = frostplot.run_summary(folder).get("resolved_scene", {})
+    beta = scene.get("materials", {}).get("rock", {}).get("solid_thermal_expansion")
+    tau = scene.get("physics", {}).get("hydraulic", {}).get("stabilization")
+    return f"β_s = {beta:g}/K, τ = {tau:g}" if beta is not None else folder
+
+
+def rock(folders, png):
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7))
+    for folder in folders:
+        m = metrics(folder)
+        t = m["time_s"] / 3600
+        label = rock_label(folder)
+        for k, point in enumerate("AB"):
+            axes[0, k].plot(t, m[f"T_{point}"], label=label)
+            axes[1, k].plot(t, 1e6 * m[f"radial_strain_{point}"], label=label)
+    for k, (point, d) in enumerate((("A", 1), ("B", 4))):
+        axes[0, k].axhline(0, color="k", lw=0.5)
+        axes[1, k].axhline(0, color="k", lw=0.5)
+        axes[0, k].set(xlabel="t [h]", ylabel="T [°C]", title=f"temperature at {point} ({d} cm from the wall)")
+        axes[1, k].set(xlabel="t [h]", ylabel="radial strain ε_rr [10⁻⁶]", title=f"radial strain at {point}")
+    axes[1, 0].legend(fontsize=8)
+    frostplot.save(fig, png)
+    root, ext = os.path.splitext(png)
+    frames = frostplot.read_fields.read_frames(folders[0])
+    hours = [h for h in (5, 10, 15) if any(abs(fr["time"] - 3600 * h) < 1 for fr in frames)]
+    fig, axes = plt.subplots(len(hours), 4, figsize=(18, 3.2 * len(hours)), squeeze=False)
+    for row, h in enumerate(hours):
+        fr = frame_at(frames, 3600 * h)
+        xy = fr["coordinates"]
+        r = np.hypot(xy[:, 0], xy[:, 1])
+        u = fr["fields"]["displacement"]
+        fr["fields"]["ice_saturation"] = 1 - fr["fields"]["liquid_saturation"]
+        fr["fields"]["radial_displacement"] = 1e6 * (u[:, 0] * xy[:, 0] + u[:, 1] * xy[:, 1]) / r
+        fr["fields"]["pore_pressure_kPa"] = fr["fields"]["pore_pressure"] / 1e3
+        for col, (name, label, cmap, zero) in enumerate((
+                ("temperature", "T [°C]", "coolwarm", True), ("ice_saturation", "S_c", "Blues", False),
+                ("radial_displacement", "u_r [µm]", "RdBu_r", True), ("pore_pressure_kPa", "p_l [kPa]", "viridis", False))):
+            frostplot.field_panel(axes[row, col], fig, fr, name, cmap=cmap, zero_line=zero, label=label)
+            axes[row, col].set_title(f"{label} at {h} h")
+    frostplot.save(fig, root + "_contours" + ext)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4))
+    for h in hours:
+        fr = frame_at(frames, 3600 * h)
+        xy = fr["coordinates"]
+        band = np.abs(xy[:, 1]) < 0.0026  # the particles along the x axis
+        d = xy[band, 0] - ROCK_HOLE
+        order = np.argsort(d)
+        s_l = fr["fields"]["liquid_saturation"][band][order]
+        phi = fr["fields"]["porosity"][band][order]
+        m_vg = 0.5
+        k = 1e-7 * np.sqrt(s_l) * (1 - (1 - s_l ** (1 / m_vg)) ** m_vg) ** 2 * (
+            phi ** 3 / (1 - phi) ** 2 * (1 - 0.224) ** 2 / 0.224 ** 3)
+        line, = axes[0].plot(1e2 * d[order], fr["fields"]["pore_pressure"][band][order] / 1e3, label=f"{h} h")
+        axes[1].plot(1e2 * d[order], s_l, color=line.get_color())
+        axes[2].semilogy(1e2 * d[order], np.maximum(k, 1e-30), color=line.get_color())
+        temperature = fr["fields"]["temperature"][band][order]
+        if temperature.min() < 0 < temperature.max():
+            front = 1e2 * float(np.interp(0.0, temperature, d[order]))
+            for ax in axes:
+                ax.axvline(front, color=line.get_color(), ls="--", lw=0.8)
+    axes[0].set(xlabel="distance from the wall d [cm]", ylabel="p_l [kPa]", title="pore pressure (dashed: 0 °C)")
+    axes[1].set(xlabel="d [cm]", ylabel="S_l", title="liquid saturation")
+    axes[2].set(xlabel="d [cm]", ylabel="k [m/s]", title="hydraulic conductivity (the scene's models)")
+    axes[0].legend()
+    frostplot.save(fig, root + "_profiles" + ext)
+
+
+def stabilization(folders, png, frame):
+    fig, axes = plt.subplots(1, len(folders), figsize=(4.6 * len(folders), 3.6), squeeze=False)
+    for ax, folder in zip(axes[0], folders):
+        fr = frostplot.read_fields.read_frames(folder)[frame]
+        fr["fields"]["pore_pressure_kPa"] = fr["fields"]["pore_pressure"] / 1e3
+        frostplot.field_panel(ax, fig, fr, "pore_pressure_kPa", cmap="viridis", label="p_l [kPa]")
+        tau = frostplot.run_summary(folder).get("resolved_scene", {}).get("physics", {}).get("hydraulic", {}).get(
+            "stabilization")
+        ax.set_title(f"τ = {tau:g}, t = {fr['time'] / 3600:.0f} h" if tau is not None else folder)
+        ax.set(xlim=(0, 0.1), ylim=(0, 0.1))
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn"])
+    parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -235,6 +328,10 @@ def main():
         thaw(args.folders, png)
     elif args.figure == "mn":
         mn(args.folders, png)
+    elif args.figure == "rock":
+        rock(args.folders, png)
+    elif args.figure == "stabilization":
+        stabilization(args.folders, png, args.frame)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

@@ -102,10 +102,8 @@ std::unique_ptr<PreparedScene> prepare(const SceneSource& source, const std::str
   prepared->task_name = task_node.as_string();
   const auto it = app::tasks().find(prepared->task_name);
   if (it == app::tasks().end()) {
-    std::string message = "unknown task '" + prepared->task_name + "'";
-    const std::string hint = closest_match(prepared->task_name, task_names);
-    if (!hint.empty()) message += "; did you mean '" + hint + "'?";
-    throw task_node.error(message + " Valid: " + join(task_names));
+    throw task_node.error("unknown task '" + prepared->task_name + "'" + did_you_mean(prepared->task_name, task_names) +
+                          " Valid: " + join(task_names));
   }
   prepared->task = it->second(app::TaskContext{prepared->registry, *prepared->loader, root});
   std::vector<std::string> valid = {"task", "plugin_paths"};

@@ -107,8 +107,8 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
           throw m.params.error("water_density", "a hydrostatic pore_pressure boundary (" + bc.label +
                                                     ") needs one water density in every material");
   if (!compressible && pressure_bcs_.empty())
-    throw InputError("physics.hydraulic: with incompressible water (water_compressibility: 0 in every material) the "
-                     "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
+    throw params_.section_error("with incompressible water (water_compressibility: 0 in every material) the "
+                                "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
   const std::size_t n = sim.particle_count(), nodes = sim.grid().node_count();
   for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,
@@ -122,6 +122,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
   constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("pore_pressure")) {
+    bc->accept_keys({"value", "hydrostatic"});
     if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
     PressureCondition c;
     c.nodes = bc->nodes;
@@ -131,6 +132,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
     pressure_bcs_.push_back(std::move(c));
   }
   for (auto* bc : sim.boundary_conditions("water_flux")) {
+    bc->accept_keys({"value"});
     const bool face = !bc->on_particles &&
                       std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
     if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");
@@ -148,7 +150,8 @@ std::vector<double> HydraulicPhysics::boundary_pressures(const PressureCondition
     if (std::isfinite(p[j])) continue;
     std::ostringstream msg;
     msg << "numerical blow-up: pore pressure boundary value " << p[j] << " from the " << c.label << " (x = " << x[0]
-        << ", y = " << x[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
+        << ", y = " << x[1] << ") at t = " << t << " s, step " << kernel_->step() << " (dt = " << kernel_->dt()
+        << " s); check the value's table or expression";
     throw NumericalBlowUp(msg.str());
   }
   return p;

@@ -102,7 +102,8 @@ void HydraulicPhysics::assemble() {
     if (!std::isfinite(q)) {
       std::ostringstream msg;
       msg << "numerical blow-up: water flux boundary value " << q << " from the " << bc.label << " at t = "
-          << time_ + dt_ << " s, step " << kernel_->step() << "; check the value's table or expression";
+          << time_ + dt_ << " s, step " << kernel_->step() << " (dt = " << dt_
+          << " s); check the value's table or expression";
       throw NumericalBlowUp(msg.str());
     }
     bc.applied = 0;

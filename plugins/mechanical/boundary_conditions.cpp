@@ -9,8 +9,15 @@
 //   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
 //                                                   the total force F [N, per m in 2-D] (Mandel)
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
-// ∂Ω_v) and record the force they exert on the material (reaction probes). A traction acting
-// on a component a velocity condition prescribes is refused: the two would fight.
+// ∂Ω_v) and record the force they exert on the material (reaction probes). Where conditions
+// meet on a node component:
+//  - two velocity conditions must prescribe the same value (a fixed base and side rollers at a
+//    corner, both 0); the first keeps the component and its reaction;
+//  - a rigid plate shares it with nothing (two plates would each carry their load);
+//  - a traction may load some held nodes (a side load reaching the fixed base's corner): the held
+//    value wins there and the traction's share goes into that condition's reaction, so no force
+//    is lost; a traction all of whose loaded nodes are held on that component is refused, since
+//    it could never act.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -24,10 +31,30 @@ namespace {
 constexpr double kMaxVelocity = 1e4;   // m/s
 constexpr double kMaxTraction = 1e10;  // Pa
 
-/// constraint_owner_ value of a node component that a rigid plate moves.
-constexpr int kPlateOwner = -2;
+/// constraint_owner_ of a node component no condition holds, and of one rigid plate k moves.
+constexpr int kFree = -1;
+int plate_owner(std::size_t k) { return -2 - static_cast<int>(k); }
 
 const char* axis_name(int d) { return d == 0 ? "x" : d == 1 ? "y" : "z"; }
+
+/// A prescribed velocity as messages give it: "0.1 m/s", "expression: 0.01*t".
+std::string velocity_text(const TimeFunction& f) {
+  return f.describe() + (f.kind() == TimeFunction::Kind::Constant ? " m/s" : "");
+}
+
+/// The keys x, y (, z) of a condition given by components.
+template <int Dim>
+std::vector<std::string> axis_keys() {
+  std::vector<std::string> keys;
+  for (int d = 0; d < Dim; ++d) keys.push_back(axis_name(d));
+  return keys;
+}
+
+template <typename T>
+std::vector<T> with(std::vector<T> items, const std::vector<T>& more) {
+  items.insert(items.end(), more.begin(), more.end());
+  return items;
+}
 
 template <int Dim>
 int read_axis(const ConfigNode& node) {
@@ -43,29 +70,48 @@ template <int Dim>
 void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
   const double end = kernel.end_time();
   const std::size_t nodes = kernel.grid().node_count();
-  constraint_owner_.assign(nodes * Dim, -1);
+  constraint_owner_.assign(nodes * Dim, kFree);
+  // The condition holding a node component (constraint_owner_ ≠ kFree), for messages.
+  auto holder = [&](int owner) {
+    return owner >= 0 ? velocity_bcs_[std::size_t(owner)].bc : plates_[std::size_t(-2 - owner)].bc;
+  };
   auto on_nodes = [](const BoundaryCondition* bc) {
     if (bc->on_particles)
       throw bc->node->error(bc->type + " acts on grid nodes: use nodes: {face: ...} or {box: ...}");
   };
+  // Velocity conditions come before plates and tractions, which check against what they hold.
   auto add_velocity = [&](BoundaryCondition* bc, std::array<std::optional<TimeFunction>, Dim> value) {
+    const int index = static_cast<int>(velocity_bcs_.size());
+    for (std::size_t i : bc->nodes)
+      for (int d = 0; d < Dim; ++d) {
+        if (!value[d]) continue;
+        int& owner = constraint_owner_[i * Dim + d];
+        if (owner == kFree) {
+          owner = index;
+          continue;
+        }
+        const VelocityCondition& other = velocity_bcs_[std::size_t(owner)];
+        if (!other.value[d]->same_values(*value[d]))
+          throw bc->node->error("the " + bc->label() + " prescribes " + axis_name(d) + " = " +
+                                velocity_text(*value[d]) + " on nodes where the " + other.bc->label() +
+                                " prescribes " + velocity_text(*other.value[d]) +
+                                ": a node component follows one value; restrict one condition's nodes");
+      }
     VelocityCondition c;
     c.bc = bc;
     c.nodes = bc->nodes;
     c.value = std::move(value);
-    const int index = static_cast<int>(velocity_bcs_.size());
-    for (std::size_t i : c.nodes)
-      for (int d = 0; d < Dim; ++d)
-        if (c.value[d] && constraint_owner_[i * Dim + d] < 0) constraint_owner_[i * Dim + d] = index;
     velocity_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("fixed")) {
+    bc->accept_keys({});
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     for (int d = 0; d < Dim; ++d) value[d] = TimeFunction::constant(0.0);
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("roller")) {
+    bc->accept_keys({"component"});
     on_nodes(bc);
     int axis = bc->face_axis;
     if (auto component = bc->node->optional_child("component")) axis = read_axis<Dim>(*component);
@@ -75,6 +121,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("velocity")) {
+    bc->accept_keys(axis_keys<Dim>());
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     bool any = false;
@@ -84,11 +131,12 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
         any = true;
       }
     if (!any)
-      throw bc->node->error("a velocity condition prescribes at least one component: x, y" +
-                            std::string(Dim == 3 ? ", z" : "") + " (m/s, a constant, table or expression)");
+      throw bc->node->error("a velocity condition prescribes at least one component: " + join(axis_keys<Dim>()) +
+                            " (m/s, a constant, table or expression)");
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("rigid_plate")) {
+    bc->accept_keys({"force"});
     on_nodes(bc);
     if (bc->face_axis < 0) throw bc->node->error("rigid_plate acts on a grid face: use nodes: {face: ...}");
     PlateCondition c;
@@ -99,10 +147,14 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     c.load = TimeFunction::read(bc->node->child("force"), 1e12, end);
     for (std::size_t i : c.nodes) {
       int& owner = constraint_owner_[i * Dim + c.axis];
-      if (owner >= 0)
-        throw bc->node->error("the " + bc->label() + " and the " + velocity_bcs_[std::size_t(owner)].bc->label() +
-                              " both prescribe the " + axis_name(c.axis) + " motion of some nodes");
-      owner = kPlateOwner;
+      if (owner != kFree) {
+        const bool two_plates = owner < kFree;
+        throw bc->node->error("the " + bc->label() + " and the " + holder(owner)->label() + " both prescribe the " +
+                              axis_name(c.axis) + " motion of some nodes" +
+                              (two_plates ? ": two plates would each carry their own load; give one the total force"
+                                          : ""));
+      }
+      owner = plate_owner(plates_.size());
     }
     plates_.push_back(std::move(c));
   }
@@ -121,26 +173,34 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     c.areas = bc->node_areas;
     for (int d = 0; d < Dim; ++d) {
       if (c.value[d].is_constant() && c.value[d](0.0) == 0.0) continue;
-      for (std::size_t i : c.nodes)
-        if (constraint_owner_[i * Dim + d] >= 0 || constraint_owner_[i * Dim + d] == kPlateOwner) {
-          const auto* other = constraint_owner_[i * Dim + d] == kPlateOwner
-                                  ? plates_.front().bc
-                                  : velocity_bcs_[std::size_t(constraint_owner_[i * Dim + d])].bc;
-          throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component of nodes that the " +
-                                other->label() + " prescribes: a velocity condition and a traction cannot both act on "
-                                "one component");
-        }
+      // Held nodes are fine as long as one node it loads is free to move (see the top of this file).
+      std::vector<std::string> holders;
+      bool acts = false;
+      for (std::size_t j = 0; j < c.nodes.size() && !acts; ++j) {
+        if (c.areas[j] <= 0) continue;
+        const int owner = constraint_owner_[c.nodes[j] * Dim + d];
+        if (owner == kFree) acts = true;
+        else if (const std::string label = holder(owner)->label();
+                 std::find(holders.begin(), holders.end(), label) == holders.end())
+          holders.push_back(label);
+      }
+      if (!acts && !holders.empty())
+        throw bc->node->error("the " + bc->label() + " loads the " + axis_name(d) + " component only of nodes the " +
+                              join(holders, " and the ") + (holders.size() > 1 ? " hold" : " holds") +
+                              ", so it could never act: a velocity condition and a traction fight on that component "
+                              "(a rigid plate's load belongs in its force:)");
     }
     traction_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("traction")) {
+    bc->accept_keys(with<std::string>({"normal", "shear"}, axis_keys<Dim>()));
     std::array<TimeFunction, Dim> value;
     bool by_components = false;
     for (int d = 0; d < Dim; ++d) by_components = by_components || bc->node->has(axis_name(d));
     const bool by_normal = bc->node->has("normal") || bc->node->has("shear");
     if (by_components == by_normal)
-      throw bc->node->error("give the traction either as normal: (and in 2-D shear:) or as components x:, y:" +
-                            std::string(Dim == 3 ? ", z:" : "") + " (Pa, tension positive)");
+      throw bc->node->error("give the traction either as normal: (and in 2-D shear:) or as components " +
+                            join(axis_keys<Dim>(), ":, ") + ": (Pa, tension positive)");
     if (by_components) {
       for (int d = 0; d < Dim; ++d)
         if (auto t = bc->node->optional_child(axis_name(d))) value[d] = TimeFunction::read(*t, kMaxTraction, end);
@@ -159,6 +219,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_traction(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("surcharge")) {
+    bc->accept_keys({"value", "normal"});
     int axis = bc->face_axis, side = bc->face_side;
     if (bc->on_particles) {
       axis = particle_normal_axis(*bc);

@@ -267,7 +267,8 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
        [this] { correct(); }},
       {"mechanical.map_to_particles",
        Phase::MapToParticles,
-       {node_velocity_.read(), velocity_.read(), position_.read(), displacement_.read()},
+       {node_velocity_.read(), velocity_.read(), position_.read(), displacement_.read(), stress_.read(), shear_.read(),
+        volume_.read(), inertia_.read()},
        {velocity_.write(), position_.write(), displacement_.write()},
        [this] { map_to_particles(); }},
   };
@@ -546,7 +547,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     std::ostringstream msg;
     msg << "numerical blow-up: the skeleton at " << kernel_->describe_particle(std::size_t(invalid))
         << " was compressed or stretched beyond its solid volume (porosity would leave (0, 1)) at t = " << time_
-        << " s, step " << kernel_->step() << "; the step may be too large or the loads too high";
+        << " s, step " << kernel_->step() << " (dt = " << dt_ << " s); the step may be too large or the loads too high";
     throw NumericalBlowUp(msg.str());
   }
 
@@ -627,8 +628,8 @@ void MechanicalPhysics<Dim>::report_failure(std::size_t p) const {
   const auto& m = materials_[kernel_->transfer().material(p)];
   std::ostringstream msg;
   msg << "numerical blow-up: mechanical model '" << m.model_name << "' could not integrate the stress at "
-      << kernel_->describe_particle(p) << " at t = " << time_ << " s, step " << kernel_->step()
-      << "; a smaller time step or other model parameters may help";
+      << kernel_->describe_particle(p) << " at t = " << time_ << " s, step " << kernel_->step() << " (dt = " << dt_
+      << " s); a smaller time step or other model parameters may help";
   throw NumericalBlowUp(msg.str());
 }
 
@@ -818,6 +819,19 @@ void MechanicalPhysics<Dim>::correct() {
   constrain(v, time_ + dt_, 1.0);
 }
 
+/// The elastic energy per volume an isotropic material with P-wave modulus M and shear modulus
+/// G stores at σ′: p²/(2K) + s:s/(4G), K = M − 4G/3 (0 where the moduli are not known).
+template <int Dim>
+double MechanicalPhysics<Dim>::elastic_energy_density(const double* s, double M, double G) {
+  const double K = M - 4.0 * G / 3.0;
+  if (!(K > 0 && G > 0)) return 0.0;
+  const double mean = (s[0] + s[1] + s[2]) / 3.0;
+  double deviatoric = 0;
+  for (int i = 0; i < 3; ++i) deviatoric += (s[i] - mean) * (s[i] - mean);
+  for (int i = 3; i < 6; ++i) deviatoric += 2.0 * s[i] * s[i];
+  return mean * mean / (2.0 * K) + deviatoric / (4.0 * G);
+}
+
 /// v_p ← flip (v_p + Σ S Δv_i) + (1 − flip) Σ S v_i, Δv_i = v_i^{k+1} − v_i^k, and the position
 /// from the grid's velocities (so that material points move as the deformation gradient says;
 /// a FLIP particle velocity the grid does not see would move them without straining them —
@@ -849,11 +863,14 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   const double* start = start_velocity_.data();
   const double* vi = v_new.data();
   const double h = kernel_->grid().min_spacing();
-  double kinetic = 0, limit = std::numeric_limits<double>::infinity();
+  const auto sigma = stress_.values();
+  const auto shear = shear_.values();
+  double kinetic = 0, elastic = 0, limit = std::numeric_limits<double>::infinity();
   auto update = [&](auto support, auto with_trapezoid) {
     constexpr bool trapezoid = decltype(with_trapezoid)::value;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic) reduction(min : limit) if (n >= kParallelMinimum)
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, elastic) reduction(min : limit) if (n >= kParallelMinimum)
     for (std::size_t p = 0; p < n; ++p) {
+      elastic += vol[p] * elastic_energy_density(sigma.data() + 6 * p, wave_modulus_[p], shear[p]);
       const auto* nodes = st.nodes(p);
       const auto* w = st.weights(p);
       std::array<double, Dim> dv{}, pic{}, move{};
@@ -892,6 +909,7 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   // The kinetic energy with the inertia the step used (mass scaling included: that is what must
   // stay small against the work for a scaled run to be quasi-static).
   kinetic_energy_ = kinetic;
+  elastic_energy_ = elastic;
   // The work of gravity, tractions and plate loads over the step, with the step's mean velocity
   // at each node the force acts on.
   const auto g = kernel_->gravity();
@@ -922,17 +940,19 @@ void MechanicalPhysics<Dim>::map_to_particles() {
     if (mass > 0) work += dt_ * c.applied[std::size_t(c.axis)] * speed / mass;
   }
   external_work_ += work;
-  // Sudden loads make the ratio large in the first steps whatever the scaling: it is watched
-  // from a tenth of the run on.
-  if (external_work_ > 0 && time_ + dt_ >= 0.1 * kernel_->end_time())
-    kinetic_to_work_max_ = std::max(kinetic_to_work_max_, kinetic_energy_ / std::abs(external_work_));
+  // Against the larger of the work done and the elastic energy stored: loads, or what heat and
+  // frost strain the skeleton with (no external work there). Sudden loads make the ratio large
+  // in the first steps whatever the scaling: it is watched from a tenth of the run on.
+  const double scale = std::max(std::abs(external_work_), elastic_energy_);
+  if (scale > 0 && time_ + dt_ >= 0.1 * kernel_->end_time())
+    kinetic_to_work_max_ = std::max(kinetic_to_work_max_, kinetic_energy_ / scale);
 }
 
 // ---- checkpoints and statistics ------------------------------------------------------------------
 
 template <int Dim>
 std::vector<PersistentArray> MechanicalPhysics<Dim>::persistent_state() {
-  saved_scalars_ = {primed_ ? 1.0 : 0.0, kinetic_energy_, external_work_, kinetic_to_work_max_};
+  saved_scalars_ = {primed_ ? 1.0 : 0.0, kinetic_energy_, external_work_, kinetic_to_work_max_, elastic_energy_};
   return {{"scalars", &saved_scalars_},
           {"temperature_of_last_update", &previous_T_},
           {"wave_modulus", &wave_modulus_},
@@ -943,7 +963,8 @@ template <int Dim>
 void MechanicalPhysics<Dim>::restored() {
   step_limit_valid_ = false;
   const auto& s = saved_scalars_;
-  if (s.size() != 4) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 4");
+  if (s.size() != 5) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 5");
+  elastic_energy_ = s[4];
   primed_ = s[0] != 0;
   kinetic_energy_ = s[1];
   external_work_ = s[2];
@@ -956,7 +977,11 @@ std::vector<std::pair<std::string, double>> MechanicalPhysics<Dim>::statistics()
           {"mechanical.kinetic_energy_scaled_J", kinetic_energy_},
           {"mechanical.external_work_J", external_work_},
           {"mechanical.kinetic_to_work_max", kinetic_to_work_max_},
-          {"mechanical.kinetic_to_work_final", external_work_ != 0 ? kinetic_energy_ / std::abs(external_work_) : 0.0}};
+          {"mechanical.elastic_energy_J", elastic_energy_},
+          {"mechanical.kinetic_to_work_final",
+           std::max(std::abs(external_work_), elastic_energy_) > 0
+               ? kinetic_energy_ / std::max(std::abs(external_work_), elastic_energy_)
+               : 0.0}};
 }
 
 template class MechanicalPhysics<2>;

@@ -103,7 +103,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;
   std::vector<PlateCondition> plates_;
-  std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition, or −1
+  std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition k ≥ 0, −1 free, −2 − k rigid plate k
 
   // ---- fields (bound by the kernel once the step is resolved)
   FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,
@@ -127,7 +127,8 @@ class MechanicalPhysics final : public Physics {
   double step_limit_ = 0;
   bool step_limit_valid_ = false;
   bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
-  double kinetic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  double kinetic_energy_ = 0, elastic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  static double elastic_energy_density(const double* stress, double p_wave_modulus, double shear_modulus);
   std::vector<double> saved_scalars_;
 
   void read_boundaries(Kernel<Dim>& kernel);

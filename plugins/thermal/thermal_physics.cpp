@@ -126,25 +126,67 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
+    bc->accept_keys({"value"});
     TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
   }
-  auto on_face = [](const BoundaryCondition* bc) {
-    return !bc->on_particles && std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
+  // A surface condition acts on a grid face, or on particles standing for a surface inside the
+  // grid (a borehole's wall): `area` is that surface [m², per m in 2-D], shared among the
+  // particles in proportion to their volume and handed to the nodes through their weights.
+  auto surface = [&](const BoundaryCondition* bc, std::vector<NodeCondition>& list) {
+    if (bc->on_particles) {
+      const ConfigNode area = bc->node->child("area");
+      const double value = area.as_real();
+      if (!(value > 0) || value > 1e6)
+        throw area.error("the surface the particles stand for must be positive (m², per m in 2-D), got " + area.as_string());
+      particle_surfaces_.push_back({bc->particles, value, &list, list.size()});
+      return;
+    }
+    if (bc->node->has("area")) throw bc->node->child("area").error("area belongs to a condition on particles; a face has its own");
+    if (!std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; }))
+      throw bc->node->error(bc->type + " acts on a grid face or on particles: use nodes: {face: ...} or particles: SHAPE with area:");
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
-    if (!on_face(bc)) throw bc->node->error("heat_flux acts on a grid face: use nodes: {face: ...}");
+    bc->accept_keys({"value", "area"});
+    surface(bc, flux_);
     flux_.push_back(
         {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
-    if (!on_face(bc)) throw bc->node->error("convective acts on a grid face: use nodes: {face: ...}");
+    bc->accept_keys({"h", "ambient", "area"});
+    surface(bc, convective_);
     const ConfigNode h = bc->node->child("h");
     const double coefficient = h.as_real();
     if (!(coefficient > 0)) throw h.error("heat transfer coefficient h must be positive (W/m^2/K)");
     convective_.push_back(
         {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, bc->label()});
+  }
+}
+
+/// The nodes and areas of surface conditions on particles, from the particles' volumes and
+/// weights: A_i = Σ_p S_ip A V_p / Σ_q V_q. Once per stencil (the particles moved or not).
+void ThermalPhysics::update_particle_surfaces() {
+  const auto& st = kernel_->transfer().stencil();
+  if (particle_surfaces_.empty() || surfaces_version_ == st.version()) return;
+  surfaces_version_ = st.version();
+  const auto vol = volume_.values();
+  const int K = st.per_particle();
+  std::vector<double> area(kernel_->grid().node_count(), 0.0);
+  for (const auto& s : particle_surfaces_) {
+    double total = 0;
+    for (std::size_t p : s.particles) total += vol[p];
+    for (std::size_t p : s.particles)
+      for (int k = 0; k < K; ++k) area[st.nodes(p)[k]] += st.weights(p)[k] * s.area * vol[p] / total;
+    auto& c = (*s.list)[s.index];
+    c.nodes.clear();
+    c.areas.clear();
+    for (std::size_t i = 0; i < area.size(); ++i)
+      if (area[i] > 0) {
+        c.nodes.push_back(i);
+        c.areas.push_back(area[i]);
+        area[i] = 0;
+      }
   }
 }
 
@@ -154,7 +196,8 @@ double ThermalPhysics::value_at(const TimeFunction& f, const std::string& label,
   if (std::isfinite(v)) return v;
   std::ostringstream msg;
   msg << "numerical blow-up: temperature boundary value " << v << " from the " << label << " (x = " << place[0]
-      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << "; check the value's table or expression";
+      << ", y = " << place[1] << ") at t = " << t << " s, step " << kernel_->step() << " (dt = " << kernel_->dt()
+      << " s); check the value's table or expression";
   throw NumericalBlowUp(msg.str());
 }
 
@@ -376,6 +419,7 @@ void ThermalPhysics::map_to_grid() {
     });
     std::fill(node_pending_.begin(), node_pending_.end(), 0.0);
   }
+  update_particle_surfaces();
   std::fill(dirichlet_.begin(), dirichlet_.end(), 0);
   apply_dirichlet_nodes(time_);
   set_dirichlet_targets(time_ + dt_);

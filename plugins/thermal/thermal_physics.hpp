@@ -100,6 +100,17 @@ class ThermalPhysics final : public Physics {
   std::vector<std::unique_ptr<EnthalpyTable>> tables_;
   std::vector<NodeCondition> fixed_T_, flux_, convective_;
   std::vector<ParticleCondition> particle_T_;
+  /// A heat_flux or convective condition on particles: the surface they stand for, and the node
+  /// condition (in flux_ or convective_) whose nodes and areas follow from them.
+  struct ParticleSurface {
+    std::vector<std::size_t> particles;
+    double area = 0;
+    std::vector<NodeCondition>* list = nullptr;
+    std::size_t index = 0;
+  };
+  std::vector<ParticleSurface> particle_surfaces_;
+  std::uint64_t surfaces_version_ = ~std::uint64_t{0};
+  void update_particle_surfaces();
 
   // ---- particles (besides the fields temperature, temperature_pic, liquid_saturation,
   // porosity and heat_deviation) ----------------------------------------------------------------

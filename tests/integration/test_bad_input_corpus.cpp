@@ -1,4 +1,4 @@
-// Every bad input refused (issue #10 §2): each case of tests/corpus/bad_input.txt, a shipped
+// Every bad input refused: each case of tests/corpus/bad_input.txt, a shipped
 // scene broken one way, must exit 2 with one `error:` line naming the file and the YAML path.
 #include <catch2/catch.hpp>
 
@@ -23,7 +23,7 @@ const std::map<std::string, std::string> kScenes = {
 
 struct Case {
   int line = 0;
-  std::string scene, expected_path, arguments;
+  std::string scene, expected_path, arguments, expected_text;
 };
 
 std::string trim(const std::string& s) {
@@ -38,9 +38,11 @@ std::vector<Case> read_corpus() {
   for (std::string line; std::getline(in, line);) {
     ++number;
     if (line.empty() || line[0] == '#') continue;
-    const auto a = line.find(" | "), b = line.find(" | ", a + 3);
+    const auto a = line.find(" | "), b = line.find(" | ", a + 3), c = line.find(" | ", b + 3);
     REQUIRE(b != std::string::npos);
-    cases.push_back({number, trim(line.substr(0, a)), trim(line.substr(a + 3, b - a - 3)), line.substr(b + 3)});
+    const std::string arguments = line.substr(b + 3, c == std::string::npos ? std::string::npos : c - b - 3);
+    const std::string text = c == std::string::npos ? std::string() : trim(line.substr(c + 3));
+    cases.push_back({number, trim(line.substr(0, a)), trim(line.substr(a + 3, b - a - 3)), arguments, text});
   }
   return cases;
 }
@@ -100,6 +102,7 @@ TEST_CASE("bad-input corpus: every case exits 2 with one error line naming file 
     const auto at = error.find("at '");
     const std::string path = at == std::string::npos ? "" : error.substr(at + 4, error.find('\'', at + 4) - at - 4);
     CHECK(path.find(c.expected_path) != std::string::npos);
+    CHECK(error.find(c.expected_text) != std::string::npos);
   }
 }
 

@@ -40,61 +40,6 @@ std::string scene_args() {
          " --set output.metrics_every=60 --set 'checkpoint={every_steps: 100, every_minutes: 0}'";
 }
 
-/// `frostmpm ARGS` running in the background, stdout and stderr into files.
-class BackgroundRun {
- public:
-  BackgroundRun(const std::string& args, const std::string& stdout_path, const std::string& stderr_path)
-      : stderr_path_(stderr_path) {
-    std::string command = "exec " + frostmpm_exe() + " " + args + " >'" + stdout_path + "' 2>'" + stderr_path + "'";
-    char sh[] = "sh", dash_c[] = "-c";
-    char* argv[] = {sh, dash_c, command.data(), nullptr};
-    // Default dispositions and no blocked signals, whatever the test runner inherited.
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    sigset_t signals;
-    sigemptyset(&signals);
-    posix_spawnattr_setsigmask(&attributes, &signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    posix_spawnattr_setsigdefault(&attributes, &signals);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-    const int status = posix_spawn(&pid_, "/bin/sh", nullptr, &attributes, argv, environ);
-    posix_spawnattr_destroy(&attributes);
-    if (status != 0) throw std::runtime_error("posix_spawn failed");
-  }
-  ~BackgroundRun() {
-    if (!exit_code_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  BackgroundRun(const BackgroundRun&) = delete;
-  BackgroundRun& operator=(const BackgroundRun&) = delete;
-
-  bool running() {
-    if (exit_code_) return false;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return false;
-  }
-  void signal(int number) const { kill(pid_, number); }
-  /// Exit code, 128 + N when ended by signal N.
-  int wait(double seconds = 120) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (running()) {
-      if (std::chrono::steady_clock::now() > deadline) FAIL("frostmpm did not exit within " << seconds << " s");
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return *exit_code_;
-  }
-  std::string stderr_text() const { return read_file(stderr_path_); }
-
- private:
-  pid_t pid_ = -1;
-  std::optional<int> exit_code_;
-  std::string stderr_path_;
-};
 
 /// Polls `done` every few milliseconds; fails if the run ends first or after `seconds`.
 template <class Predicate>

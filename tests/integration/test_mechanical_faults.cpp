@@ -1,5 +1,5 @@
 // Mechanical runs that fail or are stopped, as a user meets them: a scene that blows up exits 3
-// with one line naming the particle, its region and the time, and keeps the frames written
+// with one line naming the particle, its region, the time and the step size, and keeps the frames written
 // before it readable; a mechanical and a coupled mechanical + hydraulic run stopped with SIGTERM
 // continue with `frostmpm run --restart OUT` to the fields and metrics of an uninterrupted run,
 // bit for bit.
@@ -84,7 +84,7 @@ std::pair<int, double> read_every_frame(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region and the time, earlier frames readable",
+TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region, the time and dt, earlier frames readable",
           "[mechanical][blow-up]") {
   TempDir dir;
   const std::vector<BlowUp> cases = {
@@ -104,6 +104,8 @@ TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region and the 
       CHECK(r.output.find("in regions.0 (material '") != std::string::npos);
       const double when = blow_up_time(r.output);
       REQUIRE(when > 0);
+      CHECK(r.output.find(" s, step ") != std::string::npos);
+      CHECK(r.output.find(" (dt = ") != std::string::npos);
       CHECK(!fs::exists(out + "/run.json"));  // a run that blew up did not finish
 
       // Frames before the blow-up, complete: h5py reads every dataset, the XDMF lists each.
@@ -127,57 +129,6 @@ TEST_CASE("a mechanical blow-up exits 3 naming the particle, its region and the 
 
 namespace {
 
-/// `frostmpm ARGS` in the background with default signal dispositions, its output into a file.
-class BackgroundRun {
- public:
-  BackgroundRun(const std::string& args, const std::string& output_path) : output_path_(output_path) {
-    std::string command = "exec " + frostmpm_exe() + " " + args + " >'" + output_path + "' 2>&1";
-    char sh[] = "sh", dash_c[] = "-c";
-    char* argv[] = {sh, dash_c, command.data(), nullptr};
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    sigset_t signals;
-    sigemptyset(&signals);
-    posix_spawnattr_setsigmask(&attributes, &signals);
-    sigaddset(&signals, SIGTERM);
-    posix_spawnattr_setsigdefault(&attributes, &signals);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-    const int status = posix_spawn(&pid_, "/bin/sh", nullptr, &attributes, argv, environ);
-    posix_spawnattr_destroy(&attributes);
-    if (status != 0) throw std::runtime_error("posix_spawn failed");
-  }
-  ~BackgroundRun() {
-    if (!exit_code_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  BackgroundRun(const BackgroundRun&) = delete;
-  BackgroundRun& operator=(const BackgroundRun&) = delete;
-
-  bool running() {
-    if (exit_code_) return false;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
-    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return false;
-  }
-  void signal(int number) const { kill(pid_, number); }
-  int wait(double seconds = 300) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (running()) {
-      if (std::chrono::steady_clock::now() > deadline) FAIL("frostmpm did not exit within " << seconds << " s");
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return *exit_code_;
-  }
-  std::string output() const { return read_file(output_path_); }
-
- private:
-  pid_t pid_ = -1;
-  std::optional<int> exit_code_;
-  std::string output_path_;
-};
 
 /// Time of the last complete row of OUT/metrics.csv while a run writes it (-1 before the first).
 double metrics_time(const std::string& out) {

@@ -1,4 +1,4 @@
-// Fuzzing the shipped scenes (issue #10 §2): bench/fuzz mutates every scene in configs/ with
+// Fuzzing the shipped scenes: bench/fuzz mutates every scene in configs/ with
 // fixed seeds; each mutation must be accepted (0), refused (2, one error line) or stop as a
 // blow-up (3) — never crash, hang or end in an internal error. The longer run is bench/fuzz.
 #include <catch2/catch.hpp>

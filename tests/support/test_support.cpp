@@ -6,7 +6,13 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <chrono>
+#include <csignal>
+#include <spawn.h>
+#include <stdexcept>
 #include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
 
 #include "frostmpm/plugin/plugin_loader.hpp"
 
@@ -110,5 +116,55 @@ std::string read_file(const std::string& path) {
   ss << in.rdbuf();
   return ss.str();
 }
+
+BackgroundRun::BackgroundRun(const std::string& args, const std::string& stdout_path, const std::string& stderr_path)
+    : stdout_path_(stdout_path), stderr_path_(stderr_path) {
+  std::string command = "exec " + frostmpm_exe() + " " + args + " >'" + stdout_path + "' " +
+                        (stderr_path.empty() ? std::string("2>&1") : "2>'" + stderr_path + "'");
+  char sh[] = "sh", dash_c[] = "-c";
+  char* argv[] = {sh, dash_c, command.data(), nullptr};
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t signals;
+  sigemptyset(&signals);
+  posix_spawnattr_setsigmask(&attributes, &signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  posix_spawnattr_setsigdefault(&attributes, &signals);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  const int status = posix_spawn(&pid_, "/bin/sh", nullptr, &attributes, argv, environ);
+  posix_spawnattr_destroy(&attributes);
+  if (status != 0) throw std::runtime_error("posix_spawn failed");
+}
+
+BackgroundRun::~BackgroundRun() {
+  if (!exit_code_) {
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+}
+
+bool BackgroundRun::running() {
+  if (exit_code_) return false;
+  int status = 0;
+  if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
+  exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return false;
+}
+
+void BackgroundRun::signal(int number) const { kill(pid_, number); }
+
+int BackgroundRun::wait(double seconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (running()) {
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error("frostmpm did not exit within " + std::to_string(seconds) + " s");
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return *exit_code_;
+}
+
+std::string BackgroundRun::output() const { return read_file(stdout_path_); }
+std::string BackgroundRun::stderr_text() const { return read_file(stderr_path_.empty() ? stdout_path_ : stderr_path_); }
 
 }  // namespace frostmpm::test

@@ -1,8 +1,11 @@
 #pragma once
 // Shared helpers for tests: the registry with the built-in plugins loaded, paths into the
 // source and build trees, and running the frostmpm CLI as a user would.
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <sys/types.h>
 
 #include "frostmpm/plugin/registry.hpp"
 
@@ -54,6 +57,29 @@ CsvTable read_csv(const std::string& path);
 /// A counter of OUT/run.json's `run.counters` ("thermal.energy_balance_error_relative", ...);
 /// throws std::out_of_range naming it when absent.
 double run_counter(const std::string& out, const std::string& key);
+
+/// `frostmpm ARGS` running in the background with default signal dispositions (whatever the
+/// test runner inherited), stdout into `stdout_path` and stderr into `stderr_path` (or with
+/// stdout when empty). A run still going when the object dies is killed.
+class BackgroundRun {
+ public:
+  BackgroundRun(const std::string& args, const std::string& stdout_path, const std::string& stderr_path = "");
+  ~BackgroundRun();
+  BackgroundRun(const BackgroundRun&) = delete;
+  BackgroundRun& operator=(const BackgroundRun&) = delete;
+
+  bool running();
+  void signal(int number) const;
+  /// Exit code, 128 + N when ended by signal N; throws std::runtime_error after `seconds`.
+  int wait(double seconds = 300);
+  std::string output() const;       ///< what it wrote to stdout (and stderr, when together)
+  std::string stderr_text() const;  ///< what it wrote to stderr
+
+ private:
+  pid_t pid_ = -1;
+  std::optional<int> exit_code_;
+  std::string stdout_path_, stderr_path_;
+};
 
 /// Writes `text` to `path`.
 void write_file(const std::string& path, const std::string& text);

@@ -1,5 +1,5 @@
 // Checks the closed-form reference solutions in verification/analytic/heat_conduction.hpp
-// against published numbers (VERIFICATION.md §1.1 and §1.3) and against their own defining
+// against published numbers (Kurylyk et al. 2014; McKenzie et al. 2007) and against their own defining
 // properties (boundary values, front continuity, Stefan/flux balances, the heat equation).
 // See verification/analytic/README.md for sources.
 #include <catch2/catch.hpp>
@@ -37,7 +37,7 @@ double ddx(F&& f, double x, double h) {
   return (f(x + h) - f(x - h)) / (2.0 * h);
 }
 
-// Kurylyk et al. (2014) benchmark 1 / INTERFROST TH1: thaw of a saturated column (VERIFICATION.md §1.1).
+// Kurylyk et al. (2014) benchmark 1 / INTERFROST TH1: thaw of a saturated column (Kurylyk et al. 2014).
 fa::NeumannParams kurylyk_thaw() {
   fa::NeumannParams p{};
   p.k1 = 1.839;                                  // thawed (changed phase)
@@ -52,7 +52,7 @@ fa::NeumannParams kurylyk_thaw() {
   return p;
 }
 
-// Lunardini 3-zone parameters exactly as listed in VERIFICATION.md §1.3.
+// Lunardini 3-zone parameters exactly as listed by McKenzie et al. (2007).
 fa::LunardiniParams lunardini_doc(double Tm) {
   fa::LunardiniParams p{};
   p.k1 = 3.4644; p.k2 = 2.9414; p.k3 = 2.4184;
@@ -73,7 +73,7 @@ fa::LunardiniParams lunardini_interfrost(double Tm) {
 }
 
 struct LunardiniReference {
-  double Tm, psi, gamma, X1, X2;  // published (VERIFICATION.md §1.3), X at t = 1 d
+  double Tm, psi, gamma, X1, X2;  // published (McKenzie et al. 2007), X at t = 1 d
 };
 const LunardiniReference kLunardiniRefs[] = {
     {-4.0, 0.061727, 1.397316, 0.081290, 0.333797},
@@ -256,8 +256,8 @@ TEST_CASE("Lunardini 3-zone freezing reproduces McKenzie et al. (2007) / INTERFR
       CHECK(sol.front_frozen(kDay) == near(ref.X1, 5e-7));
       CHECK(sol.front_thawed(kDay) == near(ref.X2, 5e-7));
     }
-    SECTION("VERIFICATION.md parameter set, Tm = " + std::to_string(ref.Tm) + ": 5 significant digits") {
-      // k/C/L as rounded in VERIFICATION.md §1.3 shift the results by up to 9e-6 (relative).
+    SECTION("published parameter set, Tm = " + std::to_string(ref.Tm) + ": 5 significant digits") {
+      // k/C/L as rounded in the published parameter set shift the results by up to 9e-6 (relative).
       const fa::LunardiniSolution sol(lunardini_doc(ref.Tm));
       CHECK(sol.psi() == rel(ref.psi, 1e-5));
       CHECK(sol.gamma() == rel(ref.gamma, 1e-5));

@@ -1,6 +1,6 @@
 // Pore-water flow (plugins/hydraulic) against closed forms: steady Darcy flow in a column
 // (linear pressure, exact flux), a hydrostatic column at rest, and pressure diffusion in a
-// column against Terzaghi's series (VERIFICATION §2.1; fixed skeleton, compressible water).
+// column against Terzaghi's series (Terzaghi 1943; fixed skeleton, compressible water).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -160,7 +160,7 @@ TEST_CASE("the pressure projection (τ = 1) costs Terzaghi nothing when τ/(2G) 
 TEST_CASE("thaw with advection (Kurylyk et al. 2014, benchmarks 2 and 3): fronts of the quasi-steady closed form",
           "[verification][hydraulic][thermo-hydraulic]") {
   TempDir dir;
-  // X + (e^{−βX} − 1)/β = κ T_s β t / L_v, β = ρ_l c_l q / κ (VERIFICATION §1.2; 1–2 % approximate:
+  // X + (e^{−βX} − 1)/β = κ T_s β t / L_v, β = ρ_l c_l q / κ (1–2 % approximate:
   // it neglects the thawed zone's sensible heat, Stefan number 0.019), solved by bisection.
   auto closed_form = [](double q, double t) {
     const double kappa = 1.839, beta = 1000 * 4182 * q / kappa, rhs = kappa * 1.0 * beta * t / 1.67e8;
@@ -171,7 +171,7 @@ TEST_CASE("thaw with advection (Kurylyk et al. 2014, benchmarks 2 and 3): fronts
     }
     return 0.5 * (lo + hi);
   };
-  // The published values the closed form must reproduce first (VERIFICATION §1.2).
+  // The published values the closed form must reproduce first.
   const double q10 = 10.0 / (365.25 * 86400), q100 = 100.0 / (365.25 * 86400);
   CHECK(closed_form(q10, 86400) == Approx(0.0439).margin(5e-5));
   CHECK(closed_form(q10, 4 * 86400) == Approx(0.0882).margin(5e-5));

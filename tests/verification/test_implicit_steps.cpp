@@ -1,5 +1,5 @@
 // The implicit scheme's nonlinear solve across time steps and freezing windows: Neumann thaw
-// and freezing (VERIFICATION.md §1.1) at Δx = 2.5 mm for Δt = 1 s … 3600 s and
+// and freezing (Kurylyk et al. 2014) at Δx = 2.5 mm for Δt = 1 s … 3600 s and
 // W = 0.005, 0.02, 0.5 °C. Every step converges (a step Newton cannot finish is retried in
 // halves, never accepted — the run stops instead), energy is conserved to round-off, and the
 // front error shrinks monotonically as Δt does.

@@ -1,4 +1,4 @@
-// Two-phase Neumann problems (VERIFICATION.md §1.1): thaw (Kurylyk et al. 2014, benchmark 1)
+// Two-phase Neumann problems (Kurylyk et al. 2014): thaw (Kurylyk et al. 2014, benchmark 1)
 // and the same column frozen from the surface, with ice lighter than water (917 kg/m³) and the
 // latent heat counted with the density of ice. Both time schemes, three resolutions, and the
 // FLIP, PIC and blended particle updates.

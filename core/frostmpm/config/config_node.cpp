@@ -162,9 +162,7 @@ void ConfigNode::reject_unknown(const std::vector<std::string>& valid_keys) cons
     const std::string key = kv.first.as<std::string>();
     if (std::find(valid_keys.begin(), valid_keys.end(), key) != valid_keys.end()) continue;
     const ConfigNode offending = with(kv.first, child_path(key));  // keeps --set origins
-    std::string message = "unknown key '" + key + "'";
-    const std::string hint = closest_match(key, valid_keys);
-    message += hint.empty() ? std::string(".") : "; did you mean '" + hint + "'?";
+    std::string message = "unknown key '" + key + "'" + did_you_mean(key, valid_keys);
     message += " Valid keys here: " + (valid_keys.empty() ? std::string("(none)") : join(valid_keys));
     throw offending.error(message);
   }
@@ -248,9 +246,7 @@ void apply_override(YAML::Node& root, const std::string& assignment) {
       if (node.IsMap())
         for (const auto& kv : node) keys.push_back(kv.first.as<std::string>());
       std::string message = "--set " + path + ": path does not exist: no key '" + part + "' at '" +
-                            (walked.empty() ? "<top>" : walked) + "'";
-      const std::string hint = closest_match(part, keys);
-      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+                            (walked.empty() ? "<top>" : walked) + "'" + did_you_mean(part, keys);
       if (!keys.empty()) message += " Keys there: " + join(keys);
       throw InputError(message);
     }

@@ -47,6 +47,11 @@ std::string closest_match(const std::string& word, const std::vector<std::string
   return best_distance <= limit ? best : std::string();
 }
 
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+  const std::string hint = closest_match(word, candidates);
+  return hint.empty() ? std::string(".") : "; did you mean '" + hint + "'?";
+}
+
 std::string join(const std::vector<std::string>& items, const std::string& separator) {
   std::string out;
   for (std::size_t i = 0; i < items.size(); ++i) {

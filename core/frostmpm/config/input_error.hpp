@@ -34,6 +34,10 @@ inline constexpr int kInputErrorExitCode = 2;
 /// Closest string in `candidates` by edit distance, or "" when nothing is reasonably close.
 std::string closest_match(const std::string& word, const std::vector<std::string>& candidates);
 
+/// The end of the first sentence of an "unknown X" message: "; did you mean 'width'?" when a
+/// candidate is close, else "." — so that the list of valid ones after it reads as a sentence.
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
+
 /// "a, b, c" — used to list valid choices in messages.
 std::string join(const std::vector<std::string>& items, const std::string& separator = ", ");
 

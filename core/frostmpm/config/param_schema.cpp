@@ -226,10 +226,8 @@ ParamValue read_value(const ParamSpec& spec, const ConfigNode& node) {
       const std::string v = node.as_string();
       for (const auto& c : spec.choices)
         if (c == v) return v;
-      std::string message = "'" + v + "' is not a valid choice";
-      const std::string hint = closest_match(v, spec.choices);
-      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
-      throw node.error(message + " Valid: " + join(spec.choices));
+      throw node.error("'" + v + "' is not a valid choice" + did_you_mean(v, spec.choices) +
+                       " Valid: " + join(spec.choices));
     }
     case ParamType::RealList: {
       std::vector<double> v = node.as_reals();
@@ -253,6 +251,7 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
   valid.insert(valid.end(), also_allowed.begin(), also_allowed.end());
   node.reject_unknown(valid);
   ParamSet set;
+  set.set_section(node.where());
   for (const auto& spec : schema.params()) {
     if (node.has(spec.name)) {
       const ConfigNode value = node.child(spec.name);

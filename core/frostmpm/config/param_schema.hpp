@@ -91,6 +91,11 @@ class ParamSet {
   SourceLocation where(const std::string& name) const;
   /// Error about one parameter (cross-parameter checks in a model's constructor use this).
   InputError error(const std::string& name, const std::string& message) const;
+  /// Where the section itself was given (set by parse_params), for an error about the section as
+  /// a whole (a physics missing a boundary condition it needs).
+  const SourceLocation& section() const { return section_; }
+  InputError section_error(const std::string& message) const { return InputError(section_, message); }
+  void set_section(SourceLocation where) { section_ = std::move(where); }
 
   /// The resolved values as YAML, in schema order (for `frostmpm check` and run.json).
   YAML::Node to_yaml() const;
@@ -101,6 +106,7 @@ class ParamSet {
   std::vector<std::string> order_;
   std::map<std::string, ParamValue> values_;
   std::map<std::string, SourceLocation> where_;
+  SourceLocation section_;
   const ParamValue& get(const std::string& name) const;
 };
 

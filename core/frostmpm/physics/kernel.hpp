@@ -47,6 +47,13 @@ struct BoundaryCondition {
   std::unique_ptr<ConfigNode> node;
   /// "temperature condition 'boundary_conditions.0' on face x_min": for messages, naming the key.
   std::string label() const { return type + " condition '" + node->path() + "' on " + target_text; }
+  /// Refuses any key besides the kernel's (type, name, nodes, particles) and `keys`, the keys of
+  /// this condition's type. A physics calls it before reading them, so that a typo is reported as
+  /// itself and not as the missing key it causes.
+  void accept_keys(std::vector<std::string> keys) const {
+    keys.insert(keys.end(), {"type", "name", "nodes", "particles"});
+    node->reject_unknown(keys);
+  }
 };
 
 /// Thrown when the solution stops being finite; the message says where and when.

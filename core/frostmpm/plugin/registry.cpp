@@ -33,9 +33,7 @@ const RegistryEntry& Registry::get(const std::string& kind, const std::string& n
                                    const SourceLocation& where) const {
   if (const RegistryEntry* e = find(kind, name)) return *e;
   const auto valid = names(kind);
-  std::string message = "unknown " + kind + " model '" + name + "'";
-  const std::string hint = closest_match(name, valid);
-  if (!hint.empty()) message += "; did you mean '" + hint + "'?";
+  std::string message = "unknown " + kind + " model '" + name + "'" + did_you_mean(name, valid);
   message += " Registered: " + (valid.empty() ? std::string("(none; is the plugin path right?)") : join(valid));
   message += ". Plugin folders searched: " + (searched_.empty() ? std::string("(none)") : join(searched_));
   throw InputError(where, message);

@@ -1,6 +1,6 @@
 // Expression (expression.hpp) on muparser: our functions and constants, one parser per thread,
 // muparser's errors turned into ExpressionError with a 1-based column. The home-made compiler
-// this replaced is gone (issue #10).
+// this replaced is gone.
 #include "frostmpm/scene/expression.hpp"
 
 #include <algorithm>
@@ -122,10 +122,7 @@ std::string name_before(const std::string& text, std::size_t end, std::size_t& s
   for (const auto& c : kConstants) names.push_back(c.name);
   for (const auto& s : kSignatures) names.push_back(s.name);
   std::string detail = "unknown name '" + name + "'";
-  const std::string hint = closest_match(name, names);
-  std::string tail;
-  if (!hint.empty()) tail += "; did you mean '" + hint + "'?";
-  tail += " Valid names: ";
+  std::string tail = did_you_mean(name, names) + " Valid names: ";
   if (!variables.empty()) tail += (variables.size() == 1 ? "variable " : "variables ") + join(variables) + "; ";
   tail += "constants " + join(Expression::constant_names()) + "; functions ";
   std::vector<std::string> signatures;

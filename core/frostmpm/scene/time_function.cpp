@@ -226,6 +226,16 @@ bool TimeFunction::is_constant() const {
   return false;
 }
 
+bool TimeFunction::same_values(const TimeFunction& other) const {
+  if (is_constant() || other.is_constant())
+    return is_constant() && other.is_constant() && (*this)(0.0) == other(0.0);
+  if (kind_ != other.kind_ || scale_ != other.scale_) return false;
+  const Impl &a = *impl_, &b = *other.impl_;
+  if (kind_ == Kind::Expression) return collapse_spaces(a.expression.text()) == collapse_spaces(b.expression.text());
+  return a.times == b.times && a.values == b.values && a.interpolation == b.interpolation &&
+         a.extrapolation == b.extrapolation;
+}
+
 std::string TimeFunction::describe() const {
   switch (kind_) {
     case Kind::Constant: return number_text(value_);

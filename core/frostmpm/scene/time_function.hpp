@@ -54,6 +54,9 @@ class TimeFunction {
   /// True when the value never depends on t (a constant, an expression without t, a table of
   /// equal values that holds outside its range).
   bool is_constant() const;
+  /// True when both give the same value at every t: equal constants, or the same table or
+  /// expression (spaces aside) with the same factor. Two conditions on one node may then agree.
+  bool same_values(const TimeFunction& other) const;
   /// One-line summary: "5", "table(4 rows, linear)", "expression: 5+2*sin(2*pi*t/86400)".
   std::string describe() const;
   /// The resolved form, as it would be written in a scene.

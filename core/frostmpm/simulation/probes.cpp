@@ -105,6 +105,13 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       throw type.error("unknown probe type '" + probe->type + "'; valid: " + join(types));
     const ConfigNode name = item.child("name");
     probe->name = name.as_string();
+    const auto& reserved = leading_columns();
+    if (std::find(reserved.begin(), reserved.end(), probe->name) != reserved.end())
+      throw name.error("'" + probe->name + "' is a column metrics.csv always has (" + join(reserved) +
+                       "); give the probe another name");
+    if (probe->name.empty() || probe->name.find_first_of(",\n\r\"") != std::string::npos)
+      throw name.error("a probe name is a metrics.csv column header: not empty, and without commas, quotes or "
+                       "line breaks");
     if (const auto [it, fresh] = first_use.emplace(probe->name, name.where()); !fresh)
       throw name.error("probe name '" + probe->name + "' is used twice (first at " + it->second.describe() +
                        "); metrics.csv needs one column per name");
@@ -162,10 +169,22 @@ void Probes::read(const ConfigNode* node, Sources sources) {
     } else if (probe->type == "reaction") {
       const ConfigNode boundary = item.child("boundary");
       probe->boundary = boundary.as_string();
-      const auto& names = sources_.boundary_names;
-      if (std::find(names.begin(), names.end(), probe->boundary) == names.end())
+      const auto& named = sources_.boundaries;
+      const auto it = std::find_if(named.begin(), named.end(),
+                                   [&](const NamedBoundary& b) { return b.name == probe->boundary; });
+      if (it == named.end()) {
+        std::vector<std::string> names;
+        for (const auto& b : named) names.push_back(b.name);
         throw boundary.error("no boundary condition is named '" + probe->boundary + "'; named: " +
                              (names.empty() ? std::string("none (give one a name: key)") : join(names)));
+      }
+      // Its value would be NaN all run.
+      if (!it->has_reaction) {
+        const auto& types = sources_.reaction_types;
+        throw boundary.error("the " + it->label + " reports no reaction force; of this scene's conditions, " +
+                             (types.empty() ? std::string("none does")
+                                            : "those of type " + join(types, ", ") + " do"));
+      }
       probe->component = read_component(item.child("component"), kDim);
       item.finish({"type", "name", "boundary", "component"});
     } else {
@@ -187,8 +206,13 @@ void Probes::read(const ConfigNode* node, Sources sources) {
   }
 }
 
+const std::vector<std::string>& Probes::leading_columns() {
+  static const std::vector<std::string> columns = {"time_s", "step", "dt_s"};
+  return columns;
+}
+
 std::string Probes::header() const {
-  std::string header = "time_s,step,dt_s";
+  std::string header = join(leading_columns(), ",");
   for (const auto& probe : probes_) header += ',' + probe->name;
   return header;
 }

@@ -29,13 +29,20 @@ namespace frostmpm {
 class Probes {
  public:
   static constexpr int kDim = 2;
+  /// A boundary condition with a `name:`, which a reaction probe may name.
+  struct NamedBoundary {
+    std::string name;
+    std::string label;          ///< BoundaryCondition::label(), for messages
+    bool has_reaction = false;  ///< its physics reports the force it exerts
+  };
   /// What probes read: the particles (with their positions at the start), the transfer service,
-  /// the grid, the names of the boundary conditions a reaction may name, and the reaction of one.
+  /// the grid, the named boundary conditions and the reaction of one.
   struct Sources {
     const UniformGrid<kDim>* grid = nullptr;
     const ParticleStore* particles = nullptr;
     const Transfer<kDim>* transfer = nullptr;
-    std::vector<std::string> boundary_names;
+    std::vector<NamedBoundary> boundaries;
+    std::vector<std::string> reaction_types;  ///< types of the scene's conditions that have a reaction
     std::function<std::array<double, 3>(const std::string&)> reaction;
   };
 
@@ -50,6 +57,8 @@ class Probes {
   std::vector<double> evaluate() const;
   /// "time_s,step,dt_s,<probe names>".
   std::string header() const;
+  /// The columns metrics.csv has before the probes' (no probe may take these names).
+  static const std::vector<std::string>& leading_columns();
   YAML::Node resolved() const { return resolved_; }
 
   /// A particle field (or one component, "stress.yy", "water_flux.x") interpolated to a point

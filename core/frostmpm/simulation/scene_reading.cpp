@@ -102,6 +102,7 @@ void Simulation::read_gravity(const ConfigNode* node) {
     resolved_["gravity"] = std::vector<double>(kDim, 0.0);
     return;
   }
+  gravity_where_ = node->where();
   const auto g = node->as_reals();
   if (g.size() != kDim)
     throw node->error("gravity is a vector of " + std::to_string(kDim) + " components in m/s^2, e.g. [0, -9.81]");
@@ -271,10 +272,8 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     const ConfigNode type = item.child("type");
     bc.type = type.as_string();
     if (!bc_owner_.count(bc.type)) {
-      std::string message = "unknown boundary condition type '" + bc.type + "'";
-      const std::string hint = closest_match(bc.type, types);
-      if (!hint.empty()) message += "; did you mean '" + hint + "'?";
-      throw type.error(message + " Types of the physics in this scene: " + join(types));
+      throw type.error("unknown boundary condition type '" + bc.type + "'" + did_you_mean(bc.type, types) +
+                       " Types of the physics in this scene: " + join(types));
     }
     if (auto name = item.optional_child("name")) {
       bc.name = name->as_string();
@@ -287,6 +286,9 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     if (on_nodes == on_particles) throw item.error("give exactly one target: 'nodes:' or 'particles:'");
     if (on_nodes) {
       const ConfigNode target = item.child("nodes");
+      target.reject_unknown({"face", "range", "box"});
+      if (target.has("face") == target.has("box"))
+        throw target.error("expected {face: NAME} (with an optional range: [from, to]) or {box: {min, max}}");
       if (auto face = target.optional_child("face")) {
         bool ok = false;
         const GridFace f = GridFace::parse(face->as_string(), kDim, ok);
@@ -319,17 +321,20 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
           bc.node_areas = std::move(areas);
           bc.target_text += " within [" + number_text(r[0]) + ", " + number_text(r[1]) + "] m";
         }
-      } else if (auto box = target.optional_child("box")) {
-        const auto lo = read_point(box->child("min"));
-        const auto hi = read_point(box->child("max"));
-        box->finish({"min", "max"});
+      } else {
+        // A box has its extent already; `range:` would have been ignored.
+        if (auto range = target.optional_child("range"))
+          throw range->error("range: selects part of a face (nodes: {face: ..., range: [from, to]}); a box gives "
+                             "its extent with min: and max:");
+        const ConfigNode box = target.child("box");
+        box.reject_unknown({"min", "max"});
+        const auto lo = read_point(box.child("min"));
+        const auto hi = read_point(box.child("max"));
         bc.nodes = box_nodes<kDim>(grid_, lo, hi);
         bc.node_areas.assign(bc.nodes.size(), 0.0);
         bc.target_text = "node box";
-        if (bc.nodes.empty()) throw box->error("the box contains no grid nodes");
+        if (bc.nodes.empty()) throw box.error("the box contains no grid nodes");
       }
-      target.finish({"face", "box", "range"});
-      if (bc.nodes.empty()) throw target.error("expected {face: NAME} or {box: {min, max}}");
     } else {
       const ConfigNode target = item.child("particles");
       const RegionShape shape = read_region_shape(target);

@@ -56,6 +56,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   for (auto& physics : physics_) physics->setup(*this);
   for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
   resolve_step();
+  warn_unused_keys();
   apply_initial_values();
   read_output(root.child("output"));
   {
@@ -63,8 +64,13 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
     sources.grid = &grid_;
     sources.particles = &particles_;
     sources.transfer = &transfer_;
-    for (const auto& bc : bcs_)
-      if (!bc.name.empty()) sources.boundary_names.push_back(bc.name);
+    for (const auto& bc : bcs_) {
+      const bool has_reaction = reaction_of(bc).has_value();
+      if (has_reaction && std::find(sources.reaction_types.begin(), sources.reaction_types.end(), bc.type) ==
+                              sources.reaction_types.end())
+        sources.reaction_types.push_back(bc.type);
+      if (!bc.name.empty()) sources.boundaries.push_back({bc.name, bc.label(), has_reaction});
+    }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
     const auto probes = root.optional_child("probes");
     probes_.read(probes ? &*probes : nullptr, std::move(sources));
@@ -72,6 +78,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   }
   const auto checkpoint = root.optional_child("checkpoint");
   read_checkpoint(checkpoint ? *checkpoint : ConfigNode(YAML::Node(YAML::NodeType::Map), root.file(), "checkpoint"));
+  initialize_state();
 }
 
 Simulation::~Simulation() = default;
@@ -122,14 +129,17 @@ std::string Simulation::describe_particle(std::size_t p) const {
   return out.str();
 }
 
+std::optional<std::array<double, 3>> Simulation::reaction_of(const BoundaryCondition& bc) const {
+  const std::string& owner = bc_owner_.at(bc.type);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    if (physics_keys_[i] == owner) return physics_[i]->reaction(bc);
+  return std::nullopt;
+}
+
 std::array<double, 3> Simulation::reaction(const std::string& name) const {
-  for (const auto& bc : bcs_) {
-    if (bc.name != name) continue;
-    const std::string& owner = bc_owner_.at(bc.type);
-    for (std::size_t i = 0; i < physics_.size(); ++i)
-      if (physics_keys_[i] == owner)
-        if (const auto force = physics_[i]->reaction(bc)) return *force;
-  }
+  for (const auto& bc : bcs_)
+    if (bc.name == name)
+      if (const auto force = reaction_of(bc)) return *force;
   return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
           std::numeric_limits<double>::quiet_NaN()};
 }
@@ -156,6 +166,20 @@ void Simulation::resolve_step() {
     std::copy(half.begin(), half.end(), half0.begin());
   }
   bind_handles();
+}
+
+void Simulation::warn_unused_keys() const {
+  // Weight and inertia enter momentum balances only: without a stage predicting momentum, gravity
+  // and mass scaling change nothing, which the user should know rather than believe otherwise.
+  const auto& stages = plan_.stages();
+  if (std::any_of(stages.begin(), stages.end(), [](const Stage& s) { return s.phase == Phase::PredictMomentum; }))
+    return;
+  const std::string why = "has no effect: no physics of this scene solves a momentum balance (no stage in "
+                          "phase predict_momentum)";
+  if (gravity_where_ && std::any_of(gravity_.begin(), gravity_.end(), [](double g) { return g != 0; }))
+    log::warning(gravity_where_->describe() + ": " + why);
+  if (time_params_.real("mass_scaling") != 1.0)
+    log::warning(time_params_.where("mass_scaling").describe() + ": " + why);
 }
 
 void Simulation::bind_handles() {
@@ -206,22 +230,31 @@ void Simulation::apply_initial_values() {
         count = particles_.components(field);
       }
       const ParamSpec* spec = material_schema_.find(field);
-      auto check = [&](double value, const std::string& where) {
+      // What is wrong with a value ("is not a finite number"), empty when it is fine.
+      auto problem = [&](double value) -> std::string {
+        if (!std::isfinite(value)) return "is not a finite number";
         // A material parameter set per region obeys the material's range (porosity in (0, 1)).
-        if (!std::isfinite(value))
-          throw entry.error(where + "is not a finite number");
         if (spec && !spec->in_range(value))
-          throw entry.error(where + number_text(value) + " is outside the range of material parameter '" + field +
-                            "'; valid: " + spec->range_text());
+          return "is outside the range of material parameter '" + field + "'; valid: " + spec->range_text();
         if (std::abs(value) > state_bounds_.at(field))
-          throw entry.error(where + number_text(value) + " is beyond the plausible magnitude " +
-                            number_text(state_bounds_.at(field)) + " of '" + field + "'");
+          return "is beyond the plausible magnitude " + number_text(state_bounds_.at(field)) + " of '" + field + "'";
+        return {};
       };
       auto column = particles_.field(field);
       const int c = particles_.components(field);
-      if (entry.is_map()) {
-        const ConfigNode text = entry.child("expression");
-        entry.finish({"expression"});
+      // One value, a number or {expression: ...} of x and y, into components [k, k + n) of the
+      // region's particles.
+      auto assign = [&](const ConfigNode& value_node, int k, int n) {
+        if (!value_node.is_map()) {
+          const double value = value_node.as_real();
+          if (const auto why = problem(value); !why.empty())
+            throw value_node.error("the value " + number_text(value) + " " + why);
+          for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+            std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          return;
+        }
+        const ConfigNode text = value_node.child("expression");
+        value_node.finish({"expression"});
         Expression f;
         try {
           f = Expression::compile(text.as_string(), {"x", "y"});
@@ -231,18 +264,24 @@ void Simulation::apply_initial_values() {
         for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
           const double at[2] = {pos[p * kDim], pos[p * kDim + 1]};
           const double value = f.evaluate(at);
-          if (!std::isfinite(value) || (spec && !spec->in_range(value)) || std::abs(value) > state_bounds_.at(field)) {
-            std::ostringstream where;
-            where << "at (" << at[0] << ", " << at[1] << ") the expression gives ";
-            check(value, where.str());
-          }
-          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+          if (const auto why = problem(value); !why.empty())
+            throw value_node.error("at (" + number_text(at[0], 6) + ", " + number_text(at[1], 6) +
+                                   ") the expression's value " + number_text(value) + " " + why);
+          std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
         }
+      };
+      if (entry.is_sequence()) {
+        // One value per component, in the order of their names: solid_velocity: [0.1, 0] (x, y).
+        const auto parts = component_names(particles_.kind(field), c);
+        const auto values = entry.elements();
+        if (count == 1)
+          throw entry.error("'" + key + "' is one number: give a number or {expression: ...}, not a list");
+        if (values.size() != std::size_t(count))
+          throw entry.error("expected one value for every component of '" + field + "' (" + join(parts) + "), got " +
+                            std::to_string(values.size()) + "; or one value for all");
+        for (int k = 0; k < count; ++k) assign(values[std::size_t(k)], first + k, 1);
       } else {
-        const double value = entry.as_real();
-        check(value, "");
-        for (std::size_t p = init.range.begin; p < init.range.end; ++p)
-          for (int k = first; k < first + count; ++k) column[p * c + k] = value;
+        assign(entry, first, count);
       }
     }
   }
@@ -253,10 +292,12 @@ void Simulation::apply_initial_values() {
 void Simulation::update_stencil() {
   const long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
   if (outside < 0) return;
+  const auto p = static_cast<std::size_t>(outside);
   std::ostringstream msg;
-  msg << "numerical blow-up: " << describe_particle(static_cast<std::size_t>(outside))
+  msg << "numerical blow-up: " << describe_particle(p)
       << " has left the grid (its shape-function support reaches past the grid's edge) at t = " << time_
-      << " s, step " << step_ << "; enlarge the grid, or check the loads and boundary conditions that drive it";
+      << " s, step " << step_ << " (dt = " << dt_ << " s); enlarge the grid, or the loads drive it too far"
+      << suspects(p);
   throw NumericalBlowUp(msg.str());
 }
 
@@ -289,7 +330,6 @@ void Simulation::update_geometry() {
 }
 
 void Simulation::advance(double dt) {
-  dt_ = dt;
   auto timed = [&](const std::string& name, const std::function<void()>& fn) {
     const auto start = Clock::now();
     fn();
@@ -302,6 +342,7 @@ void Simulation::advance(double dt) {
     });
     positions_changed_ = false;
   }
+  dt_ = dt;  // after the stencil: a particle that left the grid is reported with the step that moved it
   timed("kernel.begin_step", [&] {  // the history copy (stress_start ← stress, ...)
     particles_.begin_step();
     for (auto& physics : physics_) physics->begin_step(time_, dt);
@@ -477,7 +518,7 @@ CheckedFile reopen_metrics(const OutputDir& out, const std::string& header, long
 
 }  // namespace
 
-void Simulation::run(const OutputDir& out, const RunOptions& options) {
+void Simulation::initialize_state() {
   // The stencil is needed by the first probe evaluation; it stays valid until particles move
   // (a physics may key cached grid state to its version).
   update_stencil();
@@ -486,6 +527,10 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   // run, and the checkpoint then overwrites every field and persistent array.
   for (auto& physics : physics_) physics->initialize();
   check_step_budget();
+}
+
+void Simulation::run(const OutputDir& out, const RunOptions& options) {
+  // The constructor built the initial state (initialize_state).
   LoopState loop;
   if (options.restart) {
     loop = restore_checkpoint(out.path());

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,9 @@ enum class LeavingPolicy { Stop, Remove };
 class Simulation final : public Kernel<kDim> {
  public:
   /// Reads and validates every section of a simulation scene (grid, time, gravity, materials,
-  /// physics, regions, boundary_conditions, output, probes). Throws InputError.
+  /// physics, regions, boundary_conditions, output, probes) and builds the initial state the first
+  /// step starts from (stencils, every physics' initialize()), so that `frostmpm check` refuses
+  /// all that `run` would before its first step. Throws InputError.
   Simulation(const Registry& registry, const ConfigNode& root);
   ~Simulation() override;
 
@@ -135,6 +138,10 @@ class Simulation final : public Kernel<kDim> {
 
   // simulation.cpp
   void resolve_step();
+  /// Stencils and every physics' initialize() on the initial state, then the step budget.
+  void initialize_state();
+  /// Warns about scene keys no physics of the scene uses (gravity without a momentum balance).
+  void warn_unused_keys() const;
   void bind_handles();
   /// Nodal fields kept between steps, for checkpoints.
   std::vector<PersistentArray> carried_node_fields();
@@ -152,7 +159,9 @@ class Simulation final : public Kernel<kDim> {
   void save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene);
   /// Kernel state, particle fields and persistent arrays from <dir>/checkpoint.h5.
   LoopState restore_checkpoint(const std::string& dir);
-  /// The reaction force on the boundary condition named `name`, from the physics owning it.
+  /// The force `bc` exerts on the material, from the physics owning it; none when it does not track it.
+  std::optional<std::array<double, 3>> reaction_of(const BoundaryCondition& bc) const;
+  /// The reaction force on the boundary condition named `name` (probes name only those that have one).
   std::array<double, 3> reaction(const std::string& name) const;
 
   const Registry& registry_;
@@ -162,6 +171,7 @@ class Simulation final : public Kernel<kDim> {
   Transfer<kDim> transfer_;
   ParticleStore particles_;
   std::array<double, kDim> gravity_{};
+  std::optional<SourceLocation> gravity_where_;  ///< where the scene gave `gravity:`, for warnings
   std::vector<Material> materials_;
   std::vector<BoundaryCondition> bcs_;
   std::vector<std::shared_ptr<Physics>> physics_;

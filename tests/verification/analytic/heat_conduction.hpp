@@ -303,7 +303,7 @@ class NeumannSolution {
 //    Root equations (flux continuity, common factors removed), D = erf(gamma) - erf(psi sqrt(a1/a2)):
 //      at X1:  k1 (Tm-Ts) e^{-psi^2} / (sqrt(a1) erf psi) - k2 (Tf-Tm) e^{-psi^2 a1/a2} / (sqrt(a2) D) = 0
 //      at X2:  k2 (Tf-Tm) e^{-gamma^2} / (sqrt(a2) D) - k3 (T0-Tf) e^{-gamma^2 a2/a3} / (sqrt(a3) erfc(gamma sqrt(a2/a3))) = 0
-//    (the "-" before the mushy-side term in the X1 equation is the sign VERIFICATION.md §1.3 insists on).
+//    (the "-" before the mushy-side term in the X1 equation is the sign that reproduces the published values).
 //    Solved as nested 1-D problems: for fixed gamma the X1 equation is strictly decreasing in
 //    psi on (0, gamma sqrt(a2/a1)) (+inf -> -inf), and the resulting X2 residual goes from +inf
 //    (gamma -> 0) to -inf (gamma -> inf); both are solved with brent_root.

@@ -1,0 +1,91 @@
+#!/usr/bin/python3
+"""Figures of the skeleton's verification scenes against their closed forms.
+
+    /usr/bin/python3 scripts/plot_verification.py terzaghi OUT [OUT ...] [--png FILE]
+    /usr/bin/python3 scripts/plot_verification.py mandel OUT [OUT ...] [--png FILE]
+
+terzaghi: configs/verification/terzaghi_consolidation.yaml runs (any cell sizes): the degree of
+consolidation U = settlement / (q H / E_oed) and the base pore pressure against Terzaghi's series
+(c_v = 0.1 m²/s, T_v = t / 10 s). mandel: configs/verification/mandel.yaml runs: p(0, t)/p0 at the
+centre against Mandel's series for ν = 0.3 (T = t / 50 s), with the Mandel–Cryer overshoot.
+Each OUT is a run folder; the legend shows its cell size from run.json.
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import frostplot  # noqa: E402
+from frostplot import metrics, np, plt  # noqa: E402
+
+
+def terzaghi_degree(tv, terms=400):
+    m = np.pi * (2 * np.arange(terms) + 1) / 2
+    return 1 - np.sum(2 / m[:, None] ** 2 * np.exp(-np.outer(m ** 2, np.atleast_1d(tv))), axis=0)
+
+
+def terzaghi_base_pressure(tv, terms=400):
+    m = np.pi * (2 * np.arange(terms) + 1) / 2
+    return np.sum((2 / m * np.sin(m))[:, None] * np.exp(-np.outer(m ** 2, np.atleast_1d(tv))), axis=0)
+
+
+def mandel_centre(T, nu=0.3, nu_u=0.5, terms=400):
+    from scipy.optimize import brentq
+    k = (1 - nu) / (nu_u - nu)
+    a = np.array([brentq(lambda x: np.sin(x) - k * x * np.cos(x), max(n * np.pi, 1e-9), n * np.pi + np.pi / 2)
+                  for n in range(terms)])
+    coefficient = np.sin(a) / (a - np.sin(a) * np.cos(a)) * (1 - np.cos(a))
+    return 2 * np.sum(coefficient[:, None] * np.exp(-np.outer(a ** 2, np.atleast_1d(T))), axis=0)
+
+
+def cell_label(folder):
+    scene = frostplot.run_summary(folder).get("resolved_scene", {})
+    h = scene.get("grid", {}).get("cell_size", [None])[0]
+    return f"h = {h:g} m" if h else folder
+
+
+def terzaghi(folders, png):
+    q, oedometric = 1e4, 1e6 * 0.7 / (1.3 * 0.4)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    tv = np.linspace(1e-4, 1.0, 400)
+    a.plot(tv, terzaghi_degree(tv), "k-", lw=1, label="Terzaghi")
+    b.plot(tv, terzaghi_base_pressure(tv), "k-", lw=1, label="Terzaghi")
+    for folder in folders:
+        m = metrics(folder)
+        t = m["time_s"] / 10.0
+        a.plot(t, m["settlement"] / (q * 1.0 / oedometric), ".", ms=4, label=cell_label(folder))
+        b.plot(t, m["p_base"] / q, ".", ms=4, label=cell_label(folder))
+    a.set(xlabel="T_v = c_v t / H²", ylabel="U = s / (q H / E_oed)", title="settlement")
+    b.set(xlabel="T_v", ylabel="p_base / q", title="pore pressure at the undrained base")
+    a.legend()
+    b.legend()
+    frostplot.save(fig, png)
+
+
+def mandel(folders, png):
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    T = np.linspace(1e-3, 0.6, 400)
+    ax.plot(T, mandel_centre(T), "k-", lw=1, label="Mandel (ν = 0.3)")
+    for folder in folders:
+        m = metrics(folder)
+        ax.plot(m["time_s"] / 50.0, m["p_centre"] / 1e4, ".", ms=4, label=cell_label(folder))
+    ax.axhline(1.0, color="k", lw=0.5, ls=":")
+    ax.set(xlabel="T = c t / a²", ylabel="p(0, t) / p0", title="Mandel–Cryer effect at the centre")
+    ax.legend()
+    frostplot.save(fig, png)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("figure", choices=["terzaghi", "mandel"])
+    parser.add_argument("folders", nargs="+")
+    parser.add_argument("--png", help="output file (default: FIGURE.png)")
+    args = parser.parse_args()
+    png = args.png or f"{args.figure}.png"
+    {"terzaghi": terzaghi, "mandel": mandel}[args.figure](args.folders, png)
+    print(f"wrote {png}")
+
+
+if __name__ == "__main__":
+    main()
