@@ -300,10 +300,13 @@ def rock(folders, png):
 
 def stabilization(folders, png, frame):
     fig, axes = plt.subplots(1, len(folders), figsize=(4.6 * len(folders), 3.6), squeeze=False)
-    for ax, folder in zip(axes[0], folders):
-        fr = frostplot.read_fields.read_frames(folder)[frame]
+    frames = [frostplot.read_fields.read_frames(folder)[frame] for folder in folders]
+    # One colour scale for every panel, so the oscillations of a small τ show against the others.
+    top = max(float(np.nanmax(fr["fields"]["pore_pressure"])) for fr in frames) / 1e3
+    levels = np.linspace(min(0.0, min(float(np.nanmin(fr["fields"]["pore_pressure"])) for fr in frames) / 1e3), top, 21)
+    for ax, folder, fr in zip(axes[0], folders, frames):
         fr["fields"]["pore_pressure_kPa"] = fr["fields"]["pore_pressure"] / 1e3
-        frostplot.field_panel(ax, fig, fr, "pore_pressure_kPa", cmap="viridis", label="p_l [kPa]")
+        frostplot.field_panel(ax, fig, fr, "pore_pressure_kPa", levels=levels, cmap="viridis", label="p_l [kPa]")
         tau = frostplot.run_summary(folder).get("resolved_scene", {}).get("physics", {}).get("hydraulic", {}).get(
             "stabilization")
         ax.set_title(f"τ = {tau:g}, t = {fr['time'] / 3600:.0f} h" if tau is not None else folder)
