@@ -55,6 +55,7 @@ class SimulationTask final : public Task {
         s["per_step"][key] = list;
       }
     s["particles"] = static_cast<long>(sim_.particles().size());
+    s["removed_particles"] = sim_.removed_particles();  // grid.particles_leaving: remove
     s["grid_nodes"] = static_cast<long>(sim_.grid().node_count());
     s["particle_fields"] = sim_.particles().field_names();
     s["particle_field_bytes"] = static_cast<long>(sim_.particles().bytes());

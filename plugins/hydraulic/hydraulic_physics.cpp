@@ -483,7 +483,7 @@ void HydraulicPhysics::map_to_particles() {
 std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
   saved_scalars_.push_back(double(preconditioner_updates_));
-  saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0});
+  saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0, removed_water_});
   return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
           {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
           {"nodes_with_material", &was_active_},
@@ -492,7 +492,8 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 8) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 8");
+  if (s.size() != 9) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 9");
+  removed_water_ = s[8];
   preconditioner_updates_ = long(s[4]);
   source_volume_ = s[5];
   boundary_inflow_ = s[6];
@@ -527,7 +528,20 @@ std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const
           {"hydraulic.preconditioner_updates", double(preconditioner_updates_)},
           {"hydraulic.solve_seconds", solve_seconds_},
           {"hydraulic.source_volume", source_volume_},
-          {"hydraulic.boundary_inflow_volume", boundary_inflow_}};
+          {"hydraulic.boundary_inflow_volume", boundary_inflow_},
+          {"hydraulic.water_removed_volume", removed_water_}};
+}
+
+void HydraulicPhysics::removing_particles(const ParticleRemoval& removal) {
+  if (!removal.restoring) {
+    const auto vol = volume_.values();
+    for (std::size_t p = 0; p < removal.leaving.size(); ++p)
+      if (removal.leaving[p]) removed_water_ += vol[p] * n_l_[p];  // liquid water [m³ per m]
+  }
+  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,
+                  &mobility_})
+    removal.compact(*v);
+  material_ = material_.first(removal.remaining);  // the kernel compacts its storage in place
 }
 
 FROSTMPM_REGISTER(Physics, HydraulicPhysics)

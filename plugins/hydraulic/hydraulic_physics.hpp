@@ -59,6 +59,7 @@ class HydraulicPhysics final : public Physics {
   void restored() override;
   void checkpoint_written() override;
   std::vector<std::pair<std::string, double>> statistics() const override;
+  void removing_particles(const ParticleRemoval& removal) override;
   std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const override {
     return {{"hydraulic.linear_iterations", &step_iterations_}, {"hydraulic.relative_residual", &step_residuals_}};
   }
@@ -167,6 +168,7 @@ class HydraulicPhysics final : public Physics {
   long solves_ = 0, iterations_total_ = 0, iterations_max_ = 0;
   double residual_max_ = 0, solve_seconds_ = 0;
   double source_volume_ = 0;    ///< water volume the phase change and thermal expansion removed [m³ per m]
+  double removed_water_ = 0;  ///< liquid water volume of the particles removed after leaving the grid
   double boundary_inflow_ = 0;  ///< water volume that entered through pressure and flux boundaries
   std::vector<double> saved_scalars_;
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json

@@ -952,7 +952,7 @@ void MechanicalPhysics<Dim>::map_to_particles() {
 
 template <int Dim>
 std::vector<PersistentArray> MechanicalPhysics<Dim>::persistent_state() {
-  saved_scalars_ = {primed_ ? 1.0 : 0.0, kinetic_energy_, external_work_, kinetic_to_work_max_, elastic_energy_};
+  saved_scalars_ = {primed_ ? 1.0 : 0.0, kinetic_energy_, external_work_, kinetic_to_work_max_, elastic_energy_, removed_mass_};
   return {{"scalars", &saved_scalars_},
           {"temperature_of_last_update", &previous_T_},
           {"wave_modulus", &wave_modulus_},
@@ -963,7 +963,8 @@ template <int Dim>
 void MechanicalPhysics<Dim>::restored() {
   step_limit_valid_ = false;
   const auto& s = saved_scalars_;
-  if (s.size() != 5) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 5");
+  if (s.size() != 6) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 6");
+  removed_mass_ = s[5];
   elastic_energy_ = s[4];
   primed_ = s[0] != 0;
   kinetic_energy_ = s[1];
@@ -981,7 +982,25 @@ std::vector<std::pair<std::string, double>> MechanicalPhysics<Dim>::statistics()
           {"mechanical.kinetic_to_work_final",
            std::max(std::abs(external_work_), elastic_energy_) > 0
                ? kinetic_energy_ / std::max(std::abs(external_work_), elastic_energy_)
-               : 0.0}};
+               : 0.0},
+          {"mechanical.mass_removed_kg", removed_mass_}};
+}
+
+template <int Dim>
+void MechanicalPhysics<Dim>::removing_particles(const ParticleRemoval& removal) {
+  if (!removal.restoring) {
+    const auto vol = volume_.values();
+    for (std::size_t p = 0; p < removal.leaving.size(); ++p) {
+      if (!removal.leaving[p]) continue;
+      double rho_m, skeleton, n_l;
+      densities(p, rho_m, skeleton, n_l);
+      removed_mass_ += rho_m * vol[p];  // [kg per m of thickness in 2-D]
+    }
+  }
+  for (auto* v : {&strain_increment_, &rotated_, &wave_modulus_, &previous_T_, &particle_mass_}) removal.compact(*v);
+  removal.compact(failed_);
+  for (auto& c : traction_bcs_) removal.remap(c.particles);
+  step_limit_valid_ = false;
 }
 
 template class MechanicalPhysics<2>;

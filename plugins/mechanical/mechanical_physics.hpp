@@ -55,6 +55,7 @@ class MechanicalPhysics final : public Physics {
   void restored() override;
   std::optional<std::array<double, 3>> reaction(const BoundaryCondition& bc) const override;
   std::vector<std::pair<std::string, double>> statistics() const override;
+  void removing_particles(const ParticleRemoval& removal) override;
 
  private:
   /// A velocity condition: the components it prescribes (value at time t), on nodes.
@@ -128,6 +129,7 @@ class MechanicalPhysics final : public Physics {
   bool step_limit_valid_ = false;
   bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
   double kinetic_energy_ = 0, elastic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
+  double removed_mass_ = 0;  ///< mass of the particles removed after leaving the grid
   static double elastic_energy_density(const double* stress, double p_wave_modulus, double shear_modulus);
   std::vector<double> saved_scalars_;
 

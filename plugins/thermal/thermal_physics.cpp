@@ -176,6 +176,11 @@ void ThermalPhysics::update_particle_surfaces() {
   for (const auto& s : particle_surfaces_) {
     double total = 0;
     for (std::size_t p : s.particles) total += vol[p];
+    if (!(total > 0)) {  // every particle of the surface left the grid
+      (*s.list)[s.index].nodes.clear();
+      (*s.list)[s.index].areas.clear();
+      continue;
+    }
     for (std::size_t p : s.particles)
       for (int k = 0; k < K; ++k) area[st.nodes(p)[k]] += st.weights(p)[k] * s.area * vol[p] / total;
     auto& c = (*s.list)[s.index];
@@ -229,6 +234,31 @@ double ThermalPhysics::particle_heat_total() const {
     int h = hint_[p];
     return vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
   });
+}
+
+void ThermalPhysics::removing_particles(const ParticleRemoval& removal) {
+  if (!removal.restoring && initialized_) {
+    // The heat the leaving particles carry: stored + removed = entered stays closed.
+    const auto T = temperature_.values();
+    const auto phi = porosity_.values();
+    const auto vol = volume_.values();
+    double heat = 0;
+    for (std::size_t p = 0; p < removal.leaving.size(); ++p) {
+      if (!removal.leaving[p]) continue;
+      int h = hint_[p];
+      heat += vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
+    }
+    removed_heat_ += heat;
+    if (heat_after_step_valid_) heat_after_step_ -= heat;  // not a change by deformation
+  }
+  removal.compact(conductivity_);
+  removal.compact(energy_);
+  removal.compact(hint_);
+  removal.compact(assembled_conductivity_);
+  for (auto& c : particle_T_) removal.remap(c.particles);
+  for (auto& s : particle_surfaces_) removal.remap(s.particles);
+  surfaces_version_ = ~std::uint64_t{0};
+  material_ = material_.first(removal.remaining);  // the kernel compacts its storage in place
 }
 
 void ThermalPhysics::initialize() {
@@ -569,7 +599,7 @@ std::vector<PersistentArray> ThermalPhysics::persistent_state() {
   saved_scalars_ = {double(grid_valid_), double(halvings_), previous_substep_, initial_heat_, boundary_heat_, double(nonlinear_total_),
                     double(nonlinear_max_), double(linear_total_), double(rejected_substeps_), double(substeps_),
                     double(clipped_), smallest_substep_, max_diffusivity_, min_capacity_, double(initialized_),
-                    advected_heat_, deformation_heat_, heat_after_step_, double(heat_after_step_valid_)};
+                    advected_heat_, deformation_heat_, heat_after_step_, double(heat_after_step_valid_), removed_heat_};
   return {{"node_heat", &node_heat_},
           {"node_temperature", node_T_},
           {"node_temperature_before", &node_T_before_},
@@ -579,7 +609,8 @@ std::vector<PersistentArray> ThermalPhysics::persistent_state() {
 
 void ThermalPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 19) throw std::runtime_error("thermal: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 19");
+  if (s.size() != 20) throw std::runtime_error("thermal: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 20");
+  removed_heat_ = s[19];
   advected_heat_ = s[15];
   deformation_heat_ = s[16];
   heat_after_step_ = s[17];
@@ -620,7 +651,7 @@ std::vector<std::pair<std::string, double>> ThermalPhysics::statistics() const {
   // Heat in the particles plus heat in transit (shed by particles, not yet in the grid field).
   const double pending = reproducible_sum(node_pending_.size(), [&](std::size_t i) { return node_pending_[i]; });
   const double stored = initialized_ ? particle_heat_total() + pending - initial_heat_ : 0.0;
-  const double error = stored - boundary_heat_ - deformation_heat_;
+  const double error = stored + removed_heat_ - boundary_heat_ - deformation_heat_;
   const double scale = std::max({std::abs(stored), std::abs(boundary_heat_), 1e-300});
   std::vector<std::pair<std::string, double>> out = {
       {"thermal.energy_boundary_in_J", boundary_heat_},
@@ -630,6 +661,7 @@ std::vector<std::pair<std::string, double>> ThermalPhysics::statistics() const {
       {"thermal.energy_in_transit_J", pending},
       {"thermal.energy_advected_in_J", advected_heat_},
       {"thermal.energy_deformation_J", deformation_heat_},
+      {"thermal.energy_removed_J", removed_heat_},
       {"thermal.max_principle_clips", double(clipped_)}};
   if (implicit_) {
     out.insert(out.end(), {{"thermal.nonlinear_iterations_total", double(nonlinear_total_)},

@@ -57,6 +57,7 @@ class ThermalPhysics final : public Physics {
   std::vector<PersistentArray> persistent_state() override;
   void restored() override;
   std::vector<std::pair<std::string, double>> statistics() const override;
+  void removing_particles(const ParticleRemoval& removal) override;
 
  private:
   struct NodeCondition {
@@ -153,6 +154,7 @@ class ThermalPhysics final : public Physics {
   std::vector<double> advection_force_;  ///< convective term of this step, per node [W per m]
   double advected_rate_ = 0;   ///< Σ_i advection_force_ [W per m]
   double deformation_heat_ = 0;  ///< heat change of the particles as the skeleton deformed them
+  double removed_heat_ = 0;      ///< heat of the particles removed after leaving the grid
   double heat_after_step_ = 0;    ///< Σ V_p H_p at the end of the last step (a moving skeleton)
   bool heat_after_step_valid_ = false;
   double advected_heat_ = 0;   ///< heat carried in by the flow so far (included in boundary_heat_)

@@ -4,6 +4,7 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -289,6 +290,20 @@ void CheckpointReader::read(ParticleStore& particles) const {
                         std::to_string(particles.components(name)));
       hdf5::read_reals(fields.get(), name, particles.field(name));
     }
+  });
+}
+
+std::optional<std::vector<double>> CheckpointReader::particle_field(const std::string& name) const {
+  return impl_->guarded([&]() -> std::optional<std::vector<double>> {
+    const hdf5::Handle group = hdf5::open_group(impl_->file.get(), "particles");
+    const hdf5::Handle fields = hdf5::open_group(group.get(), "fields");
+    const auto stored = hdf5::child_names(fields.get());
+    if (std::find(stored.begin(), stored.end(), name) == stored.end()) return std::nullopt;
+    const auto count = static_cast<std::size_t>(hdf5::read_integer_attribute(group.get(), "count"));
+    if (hdf5::dataset_components(fields.get(), name, 0) != 1) impl_->mismatch("field " + name + " is not a scalar");
+    std::vector<double> values(count);
+    hdf5::read_reals(fields.get(), name, values);
+    return values;
   });
 }
 

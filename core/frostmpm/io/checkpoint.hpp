@@ -20,6 +20,7 @@
 //
 // hdf5.h is included by the .cpp only.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,10 @@ class CheckpointReader {
   /// Overwrites every field of `particles`; the count, the ranges and the field set (names and
   /// components) must equal the stored ones.
   void read(ParticleStore& particles) const;
+  /// The stored values of particle field `name` (one component), or nothing when the
+  /// checkpoint has no such field: a run that removed particles stores "particle_id", the
+  /// index each remaining particle had when the scene made it.
+  std::optional<std::vector<double>> particle_field(const std::string& name) const;
   /// Keys of the physics whose arrays are stored.
   std::vector<std::string> physics_keys() const;
   /// Resizes and refills `arrays` of physics `key`; the stored array names must equal theirs.

@@ -13,6 +13,7 @@
 // the values the step began with (MOOSE's "old" material properties, Uintah's old data
 // warehouse).
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <span>
 #include <string>
@@ -71,6 +72,9 @@ class ParticleStore {
 
   /// Appends `count` particles of `material` (fields get their initial values); returns the range.
   ParticleRange append(std::size_t count, int material);
+
+  /// Drops every particle p with leaving[p] != 0 from every field; the others keep their order.
+  void remove(std::span<const std::uint8_t> leaving);
 
   std::size_t size() const { return size_; }
   const std::vector<ParticleRange>& ranges() const { return ranges_; }

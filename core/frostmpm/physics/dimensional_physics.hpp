@@ -31,6 +31,8 @@ class DimensionalPhysics : public Physics {
   void begin_step(double time, double dt) override { impl_->begin_step(time, dt); }
   std::vector<PersistentArray> persistent_state() override { return impl_->persistent_state(); }
   void restored() override { impl_->restored(); }
+  void checkpoint_written() override { impl_->checkpoint_written(); }
+  void removing_particles(const ParticleRemoval& removal) override { impl_->removing_particles(removal); }
   std::optional<std::array<double, 3>> reaction(const BoundaryCondition& bc) const override { return impl_->reaction(bc); }
   std::vector<std::pair<std::string, double>> statistics() const override { return impl_->statistics(); }
   std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const override {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <sstream>
 
 #include "frostmpm/config/param_schema.hpp"
 
@@ -37,6 +38,28 @@ struct Probes::Probe {
   std::vector<double> start;           ///< their initial coordinate along `component`
   std::string boundary;                ///< reaction: the boundary condition's name
 };
+
+void Probes::remove_particles(const ParticleRemoval& removal, double time) {
+  for (auto& probe : probes_) {
+    if (probe->particles.empty()) continue;
+    std::size_t out = 0;
+    for (std::size_t k = 0; k < probe->particles.size(); ++k) {
+      const std::size_t p = probe->particles[k];
+      if (removal.leaving[p]) continue;
+      probe->particles[out] = static_cast<std::size_t>(removal.new_index[p]);
+      probe->start[out] = probe->start[k];
+      ++out;
+    }
+    if (out == 0 && !removal.restoring) {
+      std::ostringstream msg;
+      msg << "probe '" << probe->name << "' (" << probe->type << ") follows material points that have all left the grid at t = "
+          << time << " s; enlarge the grid, or place the probe on material that stays";
+      throw NumericalBlowUp(msg.str());
+    }
+    probe->particles.resize(out);
+    probe->start.resize(out);
+  }
+}
 
 Probes::Probes() = default;
 Probes::~Probes() = default;

@@ -22,6 +22,7 @@
 #include "frostmpm/config/config_node.hpp"
 #include "frostmpm/grid/uniform_grid.hpp"
 #include "frostmpm/particles/particle_store.hpp"
+#include "frostmpm/physics/physics.hpp"
 #include "frostmpm/transfer/transfer.hpp"
 
 namespace frostmpm {
@@ -55,6 +56,9 @@ class Probes {
   void read(const ConfigNode* node, Sources sources);
   /// One value per probe, in order.
   std::vector<double> evaluate() const;
+  /// Particles left the run: the probes that follow material points follow the remaining ones.
+  /// Throws NumericalBlowUp (at `time`) when a probe's every point left, unless `restoring`.
+  void remove_particles(const ParticleRemoval& removal, double time);
   /// "time_s,step,dt_s,<probe names>".
   std::string header() const;
   /// The columns metrics.csv has before the probes' (no probe may take these names).

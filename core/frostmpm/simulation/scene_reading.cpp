@@ -46,6 +46,10 @@ void Simulation::read_grid(const ConfigNode& node) {
   s.reals("cell_size", "m", "cell size: one value (square cells) or one per axis").at_least(1e-6).at_most(1e6);
   s.choice("shape_function", shape_kind_names(), "MPM shape functions").defaults_to("gimp");
   s.integer("particles_per_cell", "particles per cell along each axis").defaults_to(2L).at_least(1).at_most(8);
+  s.choice("particles_leaving", {"stop", "remove"},
+           "a particle whose support leaves the grid: stop the run naming it, or remove it (what it carries is "
+           "counted in run.json)")
+      .defaults_to("stop");
   const ParamSet p = parse_params(s, node);
   const auto& cells = p.reals("cells");
   const auto& h = p.reals("cell_size");
@@ -67,6 +71,7 @@ void Simulation::read_grid(const ConfigNode& node) {
                                             " of memory, more than the " + bytes_text(installed) +
                                             " installed; use fewer cells or particles per cell");
   shape_ = parse_shape_kind(p.string("shape_function"));
+  leaving_ = p.string("particles_leaving") == "remove" ? LeavingPolicy::Remove : LeavingPolicy::Stop;
   grid_.ghost_layers = ghost_layers(shape_);
   transfer_.configure(shape_);
   resolved_["grid"] = p.to_yaml();
@@ -258,6 +263,13 @@ void Simulation::read_regions(const ConfigNode& node) {
   for (const auto& r : particles_.ranges())
     std::fill(material.begin() + r.begin, material.begin() + r.end, static_cast<std::uint16_t>(r.material));
   transfer_.set_materials(std::move(material));
+  if (leaving_ == LeavingPolicy::Remove) {
+    // Removal renumbers particles: each keeps the index the scene gave it, for output and restarts.
+    particles_.declare("particle_id", 1, 0.0, FieldKind::Scalar);
+    auto id = particles_.field("particle_id");
+    for (std::size_t p = 0; p < id.size(); ++p) id[p] = static_cast<double>(p);
+  }
+  initial_particles_ = particles_.size();
   resolved_["regions"] = resolved;
 }
 

@@ -123,9 +123,11 @@ std::string Simulation::describe_particle(std::size_t p) const {
   const auto pos = particles_.field("position");
   std::ostringstream out;
   out << "particle " << p << " at (" << pos[p * kDim] << ", " << pos[p * kDim + 1] << ")";
-  for (std::size_t k = 0; k < region_inits_.size(); ++k)
-    if (p >= region_inits_[k].range.begin && p < region_inits_[k].range.end)
-      out << " in regions." << k << " (material '" << materials_[region_inits_[k].range.material].name << "')";
+  if (particles_.has("particle_id")) out << " (particle_id " << particles_.field("particle_id")[p] << ")";
+  const auto& ranges = particles_.ranges();  // one per region, kept when particles are removed
+  for (std::size_t k = 0; k < ranges.size(); ++k)
+    if (p >= ranges[k].begin && p < ranges[k].end)
+      out << " in regions." << k << " (material '" << materials_[ranges[k].material].name << "')";
   return out.str();
 }
 
@@ -290,15 +292,44 @@ void Simulation::apply_initial_values() {
 // ---- geometry and the step ------------------------------------------------------------------------
 
 void Simulation::update_stencil() {
-  const long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  if (outside >= 0 && leaving_ == LeavingPolicy::Remove) {
+    // The stencil of a particle outside the grid has every weight zero (inside: they sum to 1).
+    const auto& st = transfer_.stencil();
+    const int K = st.per_particle();
+    std::vector<std::uint8_t> leaving(particles_.size(), 0);
+    for (std::size_t p = 0; p < leaving.size(); ++p) {
+      const double* w = st.weights(p);
+      leaving[p] = std::all_of(w, w + K, [](double x) { return x == 0.0; }) ? 1 : 0;
+    }
+    remove_particles(leaving, /*restoring=*/false);
+    outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  }
   if (outside < 0) return;
   const auto p = static_cast<std::size_t>(outside);
   std::ostringstream msg;
   msg << "numerical blow-up: " << describe_particle(p)
       << " has left the grid (its shape-function support reaches past the grid's edge) at t = " << time_
-      << " s, step " << step_ << " (dt = " << dt_ << " s); enlarge the grid, or the loads drive it too far"
-      << suspects(p);
+      << " s, step " << step_ << " (dt = " << dt_ << " s); enlarge the grid, let such particles go "
+      << "(grid.particles_leaving: remove), or the loads drive it too far" << suspects(p);
   throw NumericalBlowUp(msg.str());
+}
+
+void Simulation::remove_particles(std::span<const std::uint8_t> leaving, bool restoring) {
+  ParticleRemoval removal(leaving);
+  removal.restoring = restoring;
+  if (removal.remaining == 0) {
+    std::ostringstream msg;
+    msg << "numerical blow-up: every particle has left the grid at t = " << time_ << " s, step " << step_
+        << " (dt = " << dt_ << " s)";
+    throw NumericalBlowUp(msg.str());
+  }
+  probes_.remove_particles(removal, time_);
+  for (auto& physics : physics_) physics->removing_particles(removal);
+  for (auto& bc : bcs_) removal.remap(bc.particles);
+  transfer_.remove_particles(leaving);
+  particles_.remove(leaving);
+  positions_changed_ = true;
 }
 
 /// Particle volumes V = V0 det F and GIMP half-widths l_d = l0_d √(F Fᵀ)_dd: the axis-aligned
@@ -463,11 +494,25 @@ void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const 
 
 LoopState Simulation::restore_checkpoint(const std::string& dir) {
   const CheckpointReader checkpoint(dir);
+  // A run that removed particles: drop the same ones from the scene's particles first.
+  bool removed = false;
+  if (particles_.has("particle_id"))
+    if (const auto ids = checkpoint.particle_field("particle_id"); ids && ids->size() < particles_.size()) {
+      std::vector<std::uint8_t> leaving(particles_.size(), 1);
+      for (double id : *ids)
+        if (id >= 0 && id < double(leaving.size())) leaving[static_cast<std::size_t>(id)] = 0;
+      remove_particles(leaving, /*restoring=*/true);
+      removed = true;
+    }
   checkpoint.read(particles_);
   for (std::size_t i = 0; i < physics_.size(); ++i)
     checkpoint.read_physics(physics_keys_[i], physics_[i]->persistent_state());
   if (const auto carried = carried_node_fields(); !carried.empty())
     checkpoint.read_physics(kCarriedNodeFields, carried);
+  if (removed) {  // stencils for the particles that remain, before the physics rebuild their state
+    update_stencil();
+    positions_changed_ = moving_;
+  }
   LoopState loop = checkpoint.loop();
   time_ = loop.time;
   step_ = loop.step;

@@ -115,6 +115,8 @@ class Simulation final : public Kernel<kDim> {
   long restarts() const { return restarts_; }
   const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
   bool particles_move() const override { return moving_; }
+  /// Particles removed after leaving the grid (grid.particles_leaving: remove).
+  long removed_particles() const { return static_cast<long>(initial_particles_ - particles_.size()); }
 
   /// Advances one step of size dt (exposed for tests and benchmarks).
   void advance(double dt);
@@ -149,6 +151,10 @@ class Simulation final : public Kernel<kDim> {
   /// Positions moved: GIMP domains and volumes from the deformation gradient, stencils.
   void update_geometry();
   void update_stencil();
+  /// Drops the particles flagged in `leaving` from the particle fields, the transfer's materials,
+  /// the boundary conditions' and probes' particle lists and every physics (which counts what
+  /// they carry unless `restoring`).
+  void remove_particles(std::span<const std::uint8_t> leaving, bool restoring);
   void check_finite() const;
   /// Refuses a run whose physics' stable step would need more than time.max_steps steps.
   void check_step_budget() const;
@@ -195,6 +201,7 @@ class Simulation final : public Kernel<kDim> {
   double checkpoint_every_minutes_ = 0;
   bool positions_changed_ = true;
   bool moving_ = false;
+  std::size_t initial_particles_ = 0;  ///< as the scene made them
   long clamped_domains_ = 0;  ///< GIMP half-widths held at half a cell (large stretch)
   mutable bool warned_dt_cut_ = false;  ///< the fixed-step warning is given once
   StepStatistics stats_;
