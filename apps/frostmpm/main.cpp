@@ -17,6 +17,7 @@
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/io/checkpoint.hpp"
 #include "frostmpm/io/log.hpp"
+#include "frostmpm/linalg/mpi_session.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/simulation.hpp"
@@ -182,6 +183,9 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
   summary["resolved_scene"] = to_json(prepared->resolved);
   summary["run"] = to_json(prepared->task->summary());
   summary["threads"] = thread_count();
+  // MPI is linked (Trilinos needs it) but runs are not distributed: one rank, initialized only
+  // when a sparse solver ran.
+  summary["mpi"] = {{"library", mpi_library_version()}, {"ranks", 1}, {"initialized", mpi_is_active()}};
   summary["wall_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.write_text("run.json", summary.dump(2) + "\n");
@@ -215,7 +219,9 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App cli{"FrostMPM — thermo-hydro-mechanical material point method for freezing and thawing ground"};
   cli.require_subcommand(1);
-  cli.set_version_flag("--version", FROSTMPM_VERSION);
+  cli.set_version_flag("--version", std::string(FROSTMPM_VERSION) + " (" + mpi_library_version() +
+                                        " linked, runs on one rank; OpenMP: " + std::to_string(thread_count()) +
+                                        " threads by default)");
 
   SceneOptions run_options, check_options;
   std::string out_dir, restart_dir;
@@ -282,6 +288,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kInputErrorExitCode;
   }
   try {
+    refuse_multiple_ranks();
     if (*run) {
       if (threads > 0) omp_set_num_threads(threads);
       if (quiet) log::set_level(log::Level::warning);

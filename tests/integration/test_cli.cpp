@@ -310,3 +310,36 @@ TEST_CASE("describe aligns its columns and prints defaults in their shortest for
   REQUIRE(d.output.find("  floor  real  -  1e-12     (0, 1)  smallest k_r") != std::string::npos);
   REQUIRE(d.output.find("9.99999") == std::string::npos);
 }
+
+TEST_CASE("more than one MPI rank is refused with one line; --version and run.json say one rank", "[cli][bad-input]") {
+  TempDir dir;
+  write_file(dir.file("scene.yaml"), kGoodScene);
+  // As Open MPI's and MPICH's launchers announce a 3-rank world to each process.
+  for (const std::string variable : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+    const std::string out = dir.file("out_" + variable);
+    const auto r = run_command(variable + "=3 " + frostmpm_exe() + " run " + dir.file("scene.yaml") + " -o " + out);
+    INFO(r.output);
+    REQUIRE(r.exit_code == 2);
+    REQUIRE(r.output.rfind("error: frostmpm runs on one MPI rank (this launch has 3", 0) == 0);
+    REQUIRE(r.output.find("--threads") != std::string::npos);
+    REQUIRE(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+    REQUIRE(!fs::exists(out));
+  }
+  if (fs::exists("/usr/bin/mpirun")) {  // the real launcher: every rank refuses, nothing is written
+    const std::string out = dir.file("out_mpirun");
+    const auto r = run_command("/usr/bin/mpirun --allow-run-as-root --oversubscribe -np 2 " + frostmpm_exe() + " run " +
+                               dir.file("scene.yaml") + " -o " + out);
+    INFO(r.output);
+    REQUIRE(r.exit_code == 2);
+    REQUIRE(r.output.find("error: frostmpm runs on one MPI rank (this launch has 2") != std::string::npos);
+    REQUIRE(!fs::exists(out));
+  }
+  const auto version = run_frostmpm("--version");
+  REQUIRE(version.exit_code == 0);
+  REQUIRE_THAT(version.output, Catch::Contains("MPI") && Catch::Contains("runs on one rank"));
+  const auto ok = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + dir.file("one"));
+  REQUIRE(ok.exit_code == 0);
+  const auto ranks = run_command("/usr/bin/python3 -c \"import json; print(json.load(open('" + dir.file("one") +
+                                 "/run.json'))['mpi']['ranks'])\"");
+  REQUIRE(ranks.output == "1\n");
+}

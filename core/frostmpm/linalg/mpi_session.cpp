@@ -1,8 +1,12 @@
 #include "frostmpm/linalg/mpi_session.hpp"
 
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 #include <mpi.h>
+
+#include "frostmpm/config/input_error.hpp"
 
 namespace frostmpm {
 namespace {
@@ -76,6 +80,41 @@ void ensure_mpi_initialized() {
   }
   static LazyMpi lazy;  // initializes on first use (thread-safe); finalizes at exit if it owns MPI
   (void)lazy;
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size > 1) refuse_multiple_ranks();  // a launcher the environment check did not know
+}
+
+int launched_ranks() {
+  // Open MPI, PMI (MPICH's Hydra, Intel MPI), PMIx, MVAPICH.
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MV2_COMM_WORLD_SIZE"})
+    if (const char* value = std::getenv(name)) {
+      const int ranks = std::atoi(value);
+      if (ranks > 0) return ranks;
+    }
+  if (mpi_is_active()) {
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    return size;
+  }
+  return 1;
+}
+
+void refuse_multiple_ranks() {
+  const int ranks = launched_ranks();
+  if (ranks <= 1) return;
+  throw InputError("frostmpm runs on one MPI rank (this launch has " + std::to_string(ranks) +
+                   "; each would run the whole problem into the same output folder): run it without "
+                   "mpirun, and use --threads N for parallel loops");
+}
+
+std::string mpi_library_version() {
+  char text[MPI_MAX_LIBRARY_VERSION_STRING] = {};
+  int length = 0;
+  MPI_Get_library_version(text, &length);  // allowed before MPI_Init
+  std::string version(text, static_cast<std::size_t>(length > 0 ? length : 0));
+  const auto end = version.find_first_of(",\n");
+  return version.substr(0, end);
 }
 
 bool mpi_is_active() { return mpi_initialized() && !mpi_finalized(); }

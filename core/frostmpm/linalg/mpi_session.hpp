@@ -6,6 +6,8 @@
 // Rule: whoever calls MPI_Init calls MPI_Finalize; nobody initializes MPI twice or finalizes
 // MPI that someone else initialized.
 
+#include <string>
+
 namespace frostmpm {
 
 /// RAII MPI session for a program's main(). Calls MPI_Init only if MPI is not initialized yet,
@@ -35,5 +37,16 @@ void ensure_mpi_initialized();
 
 /// True when MPI is initialized and not yet finalized.
 bool mpi_is_active();
+
+/// The number of ranks the MPI launcher started (mpirun/mpiexec of Open MPI, MPICH, Intel MPI,
+/// PMIx), read from its environment without initializing MPI: 1 when not launched by one.
+int launched_ranks();
+
+/// Runs are not distributed yet: throws InputError with one line when more than one rank was
+/// launched (every rank would run the whole problem into the same output folder).
+void refuse_multiple_ranks();
+
+/// The linked MPI library, e.g. "Open MPI v4.1.4" (first line of MPI_Get_library_version).
+std::string mpi_library_version();
 
 }  // namespace frostmpm
