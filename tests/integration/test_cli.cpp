@@ -2,6 +2,7 @@
 // every bad-input case (exit code 2, one clear line, nothing written to the output folder).
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -342,4 +343,28 @@ TEST_CASE("more than one MPI rank is refused with one line; --version and run.js
   const auto ranks = run_command("/usr/bin/python3 -c \"import json; print(json.load(open('" + dir.file("one") +
                                  "/run.json'))['mpi']['ranks'])\"");
   REQUIRE(ranks.output == "1\n");
+}
+
+TEST_CASE("bad input: nested YAML aliases that expand exponentially are refused at once, naming the file",
+          "[cli][bad-input]") {
+  // 600 bytes that expand to 10^10 nodes ("billion laughs"): each level repeats the one below ten times.
+  std::string bomb = "task: freezing_curves\na0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int level = 1; level < 10; ++level) {
+    bomb += "a" + std::to_string(level) + ": &a" + std::to_string(level) + " [";
+    for (int k = 0; k < 10; ++k) bomb += (k ? ", *a" : "*a") + std::to_string(level - 1);
+    bomb += "]\n";
+  }
+  bomb += "material: *a9\n";
+  TempDir dir;
+  const auto start = std::chrono::steady_clock::now();
+  const auto r = run_bad(dir, bomb);
+  REQUIRE(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
+  REQUIRE_THAT(r.output, Catch::Contains("scene.yaml:") && Catch::Contains("aliases (*name) expand it to more than"));
+  // Aliases as a user writes them (a value given once, used twice) still work.
+  const std::string reused = replace(replace(kGoodScene, "    lambda: 0.5", "    lambda: &half 0.5"), "m: 0.5}", "m: *half}");
+  write_file(dir.file("reused.yaml"), reused);
+  const auto ok = run_frostmpm("check " + dir.file("reused.yaml"));
+  INFO(ok.output);
+  REQUIRE(ok.exit_code == 0);
+  REQUIRE(ok.output.find("m: 0.5") != std::string::npos);
 }

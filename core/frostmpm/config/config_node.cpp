@@ -6,6 +6,11 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <unordered_map>
+#include <vector>
+
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
 
 namespace frostmpm {
 
@@ -14,6 +19,72 @@ namespace {
 /// Scene files above this size are refused before reading: no scene is near it, and a
 /// device such as /dev/zero would otherwise be read until memory runs out.
 constexpr std::uintmax_t kMaxSceneBytes = 16u << 20;
+
+/// Aliases (*name) repeat an anchored node (&name) wherever they stand: nested a few levels, a
+/// few hundred bytes expand to billions of nodes (the "billion laughs"), and walking such a
+/// scene never ends. A scene has thousands of nodes at most, so the expanded count is bounded.
+constexpr double kMaxExpandedNodes = 1e6;
+
+/// Counts the nodes of a document as if every alias were written out, from the parser's events
+/// (nothing is built), and throws InputError at the first event past kMaxExpandedNodes.
+class ExpansionCounter final : public YAML::EventHandler {
+ public:
+  explicit ExpansionCounter(std::string name) : name_(std::move(name)) {}
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { leaf(mark, anchor); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const auto it = size_.find(anchor);
+    add(mark, it == size_.end() ? 1.0 : it->second);
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+    leaf(mark, anchor);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  void add(const YAML::Mark& mark, double nodes) {
+    count_ += nodes;
+    if (count_ > kMaxExpandedNodes)
+      throw InputError(SourceLocation{name_, "", mark.line + 1, mark.column + 1},
+                       "the scene's aliases (*name) expand it to more than 1000000 YAML nodes; write the repeated "
+                       "values out or use fewer nested aliases");
+  }
+  void leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    add(mark, 1.0);
+    if (anchor != YAML::NullAnchor) size_[anchor] = 1.0;
+  }
+  void open(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    open_.push_back({anchor, count_});
+    add(mark, 1.0);
+  }
+  void close() {
+    const auto [anchor, before] = open_.back();
+    open_.pop_back();
+    if (anchor != YAML::NullAnchor) size_[anchor] = count_ - before;
+  }
+  std::string name_;
+  double count_ = 0;
+  std::unordered_map<YAML::anchor_t, double> size_;
+  std::vector<std::pair<YAML::anchor_t, double>> open_;
+};
+
+void check_alias_expansion(const std::string& text, const std::string& name) {
+  if (text.find('*') == std::string::npos) return;  // no alias: nothing to expand
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  ExpansionCounter counter(name);
+  while (parser.HandleNextDocument(counter)) {
+  }
+}
 
 /// yaml-cpp keeps the first of two equal keys and drops the second silently: refuse both,
 /// naming their lines, anywhere in the tree.
@@ -70,6 +141,7 @@ std::string ConfigNode::read_file(const std::string& file) {
 
 ConfigNode ConfigNode::load_string(const std::string& text, const std::string& name) {
   try {
+    check_alias_expansion(text, name);
     YAML::Node root = YAML::Load(text);
     if (!root.IsMap())
       throw InputError(name + ": a scene must be a YAML mapping of sections (key: value)");
