@@ -27,6 +27,7 @@ import csv
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -279,6 +280,7 @@ def main():
         else:
             if not reuse:
                 cmd = command(args.frostmpm, out, scheme, h, cfl, dt)
+                shutil.rmtree(out, ignore_errors=True)  # frostmpm refuses to overwrite an earlier run
                 start = time.monotonic()
                 proc = subprocess.run(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
                 spent += time.monotonic() - start

@@ -145,19 +145,43 @@ nlohmann::json to_json(const YAML::Node& node) {
   }
 }
 
+/// A new run into a folder that holds another run's results would replace them without a word:
+/// refused unless `overwrite` (then the new run replaces them file by file, as it writes).
+void refuse_earlier_results(const std::string& dir, bool overwrite, const std::string& program) {
+  if (overwrite) {  // the new run replaces the rest as it writes; an old checkpoint would outlive it
+    std::error_code ec;
+    fs::remove(fs::path(dir) / "checkpoint.h5", ec);
+    return;
+  }
+  std::vector<std::string> found;
+  for (const char* name : {"run.json", "metrics.csv", "fields.h5", "fields.xdmf", "checkpoint.h5"}) {
+    std::error_code ec;
+    if (fs::exists(fs::path(dir) / name, ec)) found.push_back(name);
+  }
+  if (found.empty()) return;
+  std::string listed;
+  for (const auto& name : found) listed += (listed.empty() ? "" : ", ") + name;
+  const bool resumable = std::find(found.begin(), found.end(), "checkpoint.h5") != found.end();
+  throw InputError(dir + ": holds the results of an earlier run (" + listed + "); give another -o, add --overwrite " +
+                   "to replace them" +
+                   (resumable ? ", or continue that run with: " + shell_word(program) + " run --restart " + shell_word(dir)
+                              : std::string()));
+}
+
 /// `frostmpm run`: a new run of `o.scene`, or with `restart_dir` the continuation of the run
 /// in that folder from its checkpoint (which holds the scene, overrides and plugin paths).
-int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string& restart_dir,
+int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string& restart_dir, bool overwrite,
             const std::string& program) {
   const auto start = std::chrono::steady_clock::now();
   const bool restart = !restart_dir.empty();
-  if (restart && (!o.scene.empty() || !out_dir.empty() || !o.overrides.empty() || !o.plugin_paths.empty()))
-    throw InputError("--restart OUT takes no scene, -o, --set or --plugin-path: the checkpoint in OUT holds them");
+  if (restart && (!o.scene.empty() || !out_dir.empty() || !o.overrides.empty() || !o.plugin_paths.empty() || overwrite))
+    throw InputError("--restart OUT takes no scene, -o, --set, --plugin-path or --overwrite: the checkpoint in OUT holds them");
   if (!restart && o.scene.empty()) throw InputError("give a scene file to run, or --restart OUT to continue a run");
   const SceneSource source = restart ? CheckpointReader(restart_dir).scene() : scene_source(o);
   auto prepared = prepare(source, restart ? source.path : o.scene);
   const std::string dir =
       restart ? restart_dir : out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
+  if (!restart) refuse_earlier_results(dir, overwrite, program);
   OutputDir out(dir);
   log::debug("task '" + prepared->task_name + "' on " + std::to_string(thread_count()) + " thread(s), output in " + dir);
   std::optional<RunInterrupted> interrupted;
@@ -228,6 +252,8 @@ int main(int argc, char** argv) {
   auto* run = cli.add_subcommand("run", "run a scene, or continue a stopped run with --restart OUT");
   add_scene_options(run, run_options, /*scene_required=*/false);  // not with --restart
   run->add_option("-o,--output", out_dir, "output folder (default: frostmpm-out/<scene name>)");
+  bool overwrite = false;
+  run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
   run->add_option("--restart", restart_dir,
                   "continue the run in folder OUT from OUT/checkpoint.h5, appending to its outputs "
                   "(give nothing else: the checkpoint holds the scene, overrides and plugin paths)")
@@ -293,7 +319,7 @@ int main(int argc, char** argv) {
       if (threads > 0) omp_set_num_threads(threads);
       if (quiet) log::set_level(log::Level::warning);
       if (verbose) log::set_level(log::Level::debug);
-      return cmd_run(run_options, out_dir, restart_dir, argv[0]);
+      return cmd_run(run_options, out_dir, restart_dir, overwrite, argv[0]);
     }
     if (*check) return cmd_check(check_options);
     if (*plugins) return app::cmd_plugins(list_paths, std::cout);

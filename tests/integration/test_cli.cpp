@@ -312,7 +312,7 @@ TEST_CASE("describe aligns its columns and prints defaults in their shortest for
   REQUIRE(d.output.find("9.99999") == std::string::npos);
 }
 
-TEST_CASE("more than one MPI rank is refused with one line; --version and run.json say one rank", "[cli][bad-input]") {
+TEST_CASE("more than one MPI rank is refused with one line, and --version and run.json say one rank", "[cli][bad-input]") {
   TempDir dir;
   write_file(dir.file("scene.yaml"), kGoodScene);
   // As Open MPI's and MPICH's launchers announce a 3-rank world to each process.
@@ -367,4 +367,31 @@ TEST_CASE("bad input: nested YAML aliases that expand exponentially are refused 
   INFO(ok.output);
   REQUIRE(ok.exit_code == 0);
   REQUIRE(ok.output.find("m: 0.5") != std::string::npos);
+}
+
+TEST_CASE("run into a folder that holds an earlier run's results is refused without --overwrite", "[cli][bad-input]") {
+  TempDir dir;
+  write_file(dir.file("scene.yaml"), kGoodScene);
+  const std::string out = dir.file("out");
+  REQUIRE(run_frostmpm("run " + dir.file("scene.yaml") + " -o " + out).exit_code == 0);
+  const std::string first = read_file(out + "/run.json");
+  const auto again = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + out);
+  INFO(again.output);
+  REQUIRE(again.exit_code == 2);
+  REQUIRE(again.output.rfind("error: " + out + ": holds the results of an earlier run (run.json", 0) == 0);
+  REQUIRE(again.output.find("--overwrite") != std::string::npos);
+  REQUIRE(std::count(again.output.begin(), again.output.end(), '\n') == 1);
+  REQUIRE(read_file(out + "/run.json") == first);  // untouched
+  // A folder with a checkpoint also says how to continue it.
+  write_file(out + "/checkpoint.h5", "");
+  const auto stopped = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + out);
+  REQUIRE(stopped.exit_code == 2);
+  REQUIRE(stopped.output.find("checkpoint.h5); give another -o, add --overwrite to replace them, or continue that run "
+                              "with: ") != std::string::npos);
+  // --overwrite replaces the results and drops the old checkpoint.
+  const auto replaced = run_frostmpm("run " + dir.file("scene.yaml") + " -o " + out + " --overwrite");
+  INFO(replaced.output);
+  REQUIRE(replaced.exit_code == 0);
+  REQUIRE(!fs::exists(out + "/checkpoint.h5"));
+  REQUIRE(run_frostmpm("run --restart " + out + " --overwrite").exit_code == 2);
 }

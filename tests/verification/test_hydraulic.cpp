@@ -189,7 +189,7 @@ TEST_CASE("thaw with advection (Kurylyk et al. 2014, benchmarks 2 and 3): fronts
       cmd << "run " << source_dir() << "/configs/verification/kurylyk_advection.yaml -o " << dir.file("run")
           << " --set 'grid.cells=[1," << cells << "]' --set grid.cell_size=" << h
           << " --set 'regions.0.shape={box: {min: [0, 0], max: [" << h << ", 0.5]}}' --set '" << flux.str()
-          << "' --set output.progress=false";
+          << "' --set output.progress=false --overwrite";  // one folder for every run
       const auto r = run_frostmpm(cmd.str());
       INFO(r.output);
       REQUIRE(r.exit_code == 0);
