@@ -13,7 +13,7 @@ class ConstantConductivity : public AbsolutePermeabilityModel {
 
   static ParamSchema schema() {
     ParamSchema s;
-    s.real("k0", "m/s", "hydraulic conductivity").above(0);
+    s.real("k0", "m/s", "hydraulic conductivity").above(0).at_most(10);
     return s;
   }
 
@@ -39,10 +39,10 @@ class IntrinsicPermeability final : public ConstantConductivity {
 
   static ParamSchema schema() {
     ParamSchema s;
-    s.real("permeability", "m^2", "intrinsic permeability k").above(0);
-    s.real("fluid_density", "kg/m^3", "ρ_l").defaults_to(1000.0).above(0);
-    s.real("fluid_viscosity", "Pa s", "dynamic viscosity μ (INTERFROST: 1.793e-3)").defaults_to(1.793e-3).above(0);
-    s.real("gravity", "m/s^2", "g").defaults_to(9.81).above(0);
+    s.real("permeability", "m^2", "intrinsic permeability k").above(0).at_most(1e-3);
+    s.real("fluid_density", "kg/m^3", "ρ_l").defaults_to(1000.0).above(0).at_most(3e4);
+    s.real("fluid_viscosity", "Pa s", "dynamic viscosity μ (INTERFROST: 1.793e-3)").defaults_to(1.793e-3).above(0).at_most(1e3);
+    s.real("gravity", "m/s^2", "g").defaults_to(9.81).above(0).at_most(1e3);
     return s;
   }
 

@@ -14,7 +14,7 @@ class KozenyCarman final : public AbsolutePermeabilityModel {
 
   static ParamSchema schema() {
     ParamSchema s;
-    s.real("k0", "m/s", "hydraulic conductivity at the reference porosity").above(0);
+    s.real("k0", "m/s", "hydraulic conductivity at the reference porosity").above(0).at_most(10);
     s.real("reference_porosity", "-", "φ_0 at which k_a = k0").above(0).below(1);
     return s;
   }

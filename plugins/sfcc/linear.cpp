@@ -12,8 +12,8 @@ class LinearSfcc final : public SfccModel {
 
   static ParamSchema schema() {
     ParamSchema s;
-    s.real("freezing_point", "degC", "T_f: fully thawed at and above").defaults_to(0.0);
-    s.real("mushy_end", "degC", "T_m (< T_f): residual saturation reached at and below");
+    s.real("freezing_point", "degC", "T_f: fully thawed at and above").defaults_to(0.0).at_least(-273.15).at_most(100);
+    s.real("mushy_end", "degC", "T_m (< T_f): residual saturation reached at and below").at_least(-273.15).at_most(100);
     s.real("residual_saturation", "-", "S_res below T_m").at_least(0).below(1);
     return s;
   }

@@ -18,10 +18,10 @@ class VanGenuchtenClausiusClapeyron final : public SfccModel {
   static ParamSchema schema() {
     ParamSchema s;
     s.real("lambda", "-", "shape constant λ; larger is steeper").above(0).below(1);
-    s.real("p0", "Pa", "air-entry-like pressure scale p_0").above(0);
-    s.real("ice_density", "kg/m^3", "intrinsic ice density ρ_c").defaults_to(917.0).above(0);
-    s.real("water_density", "kg/m^3", "intrinsic liquid density ρ_l").defaults_to(1000.0).above(0);
-    s.real("latent_heat", "J/kg", "latent heat of fusion L_f").defaults_to(3.34e5).above(0);
+    s.real("p0", "Pa", "air-entry-like pressure scale p_0").above(0).at_most(1e10);
+    s.real("ice_density", "kg/m^3", "intrinsic ice density ρ_c").defaults_to(917.0).above(0).at_most(3e4);
+    s.real("water_density", "kg/m^3", "intrinsic liquid density ρ_l").defaults_to(1000.0).above(0).at_most(3e4);
+    s.real("latent_heat", "J/kg", "latent heat of fusion L_f").defaults_to(3.34e5).above(0).at_most(1e8);
     s.real("residual_saturation", "-", "S_res, liquid saturation far below freezing")
         .defaults_to(0.0).at_least(0).below(1);
     return s;

@@ -11,13 +11,15 @@ ParamSchema material_schema() {
   ParamSchema s;
   declare_pore_space_keys(s);
   declare_solid_density(s);
-  s.real("solid_heat_capacity", "J/kg/K", "specific heat capacity of the solid c_s").above(0);
-  s.real("solid_conductivity", "W/m/K", "thermal conductivity of the solid κ_s").above(0);
-  s.real("water_heat_capacity", "J/kg/K", "specific heat capacity of water c_l").defaults_to(4182.0).above(0);
-  s.real("water_conductivity", "W/m/K", "thermal conductivity of water κ_l").defaults_to(0.6).above(0);
-  s.real("ice_heat_capacity", "J/kg/K", "specific heat capacity of ice c_c").defaults_to(2060.0).above(0);
-  s.real("ice_conductivity", "W/m/K", "thermal conductivity of ice κ_c").defaults_to(2.14).above(0);
-  s.real("latent_heat", "J/kg", "latent heat of fusion L_f").defaults_to(3.34e5).at_least(0);
+  // Upper bounds well past any material (heat capacities ≤ 1.5e4 J/kg/K, diamond conducts
+  // ≈ 2e3 W/m/K): a value beyond them is a typo or a unit slip, not a soil.
+  s.real("solid_heat_capacity", "J/kg/K", "specific heat capacity of the solid c_s").above(0).at_most(1e5);
+  s.real("solid_conductivity", "W/m/K", "thermal conductivity of the solid κ_s").above(0).at_most(1e4);
+  s.real("water_heat_capacity", "J/kg/K", "specific heat capacity of water c_l").defaults_to(4182.0).above(0).at_most(1e5);
+  s.real("water_conductivity", "W/m/K", "thermal conductivity of water κ_l").defaults_to(0.6).above(0).at_most(1e4);
+  s.real("ice_heat_capacity", "J/kg/K", "specific heat capacity of ice c_c").defaults_to(2060.0).above(0).at_most(1e5);
+  s.real("ice_conductivity", "W/m/K", "thermal conductivity of ice κ_c").defaults_to(2.14).above(0).at_most(1e4);
+  s.real("latent_heat", "J/kg", "latent heat of fusion L_f").defaults_to(3.34e5).at_least(0).at_most(1e8);
   return s;
 }
 

@@ -8,8 +8,9 @@ namespace frostmpm {
 /// porosity φ, water density ρ_l and ice density ρ_c.
 inline void declare_pore_space_keys(ParamSchema& s) {
   s.real("porosity", "-", "porosity φ (pore space filled by water and ice)").above(0).below(1);
-  s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0);
-  s.real("ice_density", "kg/m^3", "intrinsic density of ice ρ_c").defaults_to(917.0).above(0);
+  // Upper bounds: no pore fluid or ice is denser than the densest solids (≈ 2.3e4 kg/m³).
+  s.real("water_density", "kg/m^3", "intrinsic density of liquid water ρ_l").defaults_to(1000.0).above(0).at_most(3e4);
+  s.real("ice_density", "kg/m^3", "intrinsic density of ice ρ_c").defaults_to(917.0).above(0).at_most(3e4);
 }
 
 /// The solid grains' intrinsic density ρ_s (thermal: heat capacity; mechanical: weight, inertia).
