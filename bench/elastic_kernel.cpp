@@ -32,11 +32,9 @@
 // parallel, the particles of a block in index order. A checksum of the final state is printed;
 // it is identical on any thread count.
 #include <omp.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -44,6 +42,8 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "kernel_timing.hpp"
 
 #include "frostmpm/parallel/parallel.hpp"
 
@@ -56,8 +56,6 @@ using frostmpm::thread_count;
 constexpr int kPerCell = 2;  // particles per cell along each axis, as in the scenes
 constexpr int kGhost = 1;    // node layers past the domain on every side
 constexpr double kYoung = 1.0e6, kPoisson = 0.3, kDensity = 2000.0, kGravity = -9.81, kCfl = 0.5;
-
-using Clock = std::chrono::steady_clock;
 
 /// uGIMP in one dimension (linear grid basis, hat-shaped particle domain of half-width lp, in
 /// cell units): weights and derivatives (per cell) on the three nodes base, base+1, base+2
@@ -357,82 +355,34 @@ struct ElasticKernel {
   }
 };
 
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-/// CPU seconds of every thread of this process so far (user + system).
-double process_cpu_seconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App cli{"minimal explicit elastic MPM step (GIMP, USF, FLIP) as the reference kernel of "
                "bench/mechanical_throughput"};
-  long particles = 120000;
-  int threads = 0, repeat = 5, steps = 0;
-  double work = 2e6, max_seconds = 5.0;
-  bool json = false;
-  cli.add_option("--particles", particles,
-                 "particle count on a 3 m x 1 m block of cells 3n x n, 2 x 2 per cell (rounded to 12 n^2)")
-      ->check(CLI::PositiveNumber);
-  cli.add_option("--threads", threads, "OpenMP threads (default: OMP_NUM_THREADS or all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cli.add_option("--repeat", repeat, "timed repetitions; the median and best are reported")->check(CLI::PositiveNumber);
-  cli.add_option("--steps", steps, "steps per repetition (default: --work / particles)")->check(CLI::NonNegativeNumber);
-  cli.add_option("--work", work, "particle-steps per repetition when --steps is not given")
-      ->check(CLI::PositiveNumber);
-  cli.add_option("--max-seconds", max_seconds,
-                 "stop repeating once the timed repetitions took this long; at least one repetition runs")
-      ->check(CLI::PositiveNumber);
-  cli.add_flag("--json", json, "print one JSON object instead of lines");
+  frostmpm::bench::TimingOptions o;
+  frostmpm::bench::add_timing_options(cli, o);
   CLI11_PARSE(cli, argc, argv);
-  if (threads > 0) omp_set_num_threads(threads);
+  if (o.threads > 0) omp_set_num_threads(o.threads);
 
-  const int cells_y = std::max(1, static_cast<int>(std::lround(std::sqrt(particles / 12.0))));
+  const int cells_y = frostmpm::bench::block_cells_y(o.particles);
   ElasticKernel kernel(3 * cells_y, cells_y, 3.0);
-
-  // The step count depends on the size only, never on timing, so the checksum of a given
-  // command line is the same on any thread count (unless --max-seconds cuts the repetitions).
-  if (steps == 0) steps = std::max(1, static_cast<int>(std::ceil(work / static_cast<double>(kernel.n))));
-  kernel.step();  // warm-up, not timed: first touch of every array, thread start-up
-
-  std::vector<double> rates;
-  double timed_seconds = 0;
-  const double cpu_start = process_cpu_seconds();
-  for (int r = 0; r < repeat && timed_seconds < max_seconds; ++r) {
-    const auto start = Clock::now();
-    for (int s = 0; s < steps; ++s) kernel.step();
-    const double seconds = seconds_since(start);
-    timed_seconds += seconds;
-    rates.push_back(static_cast<double>(kernel.n) * steps / seconds);
-  }
-  const int repetitions = static_cast<int>(rates.size());
-  const double cpu_share = (process_cpu_seconds() - cpu_start) / (timed_seconds * thread_count());
-  std::sort(rates.begin(), rates.end());
-  const double median = rates.size() % 2 ? rates[rates.size() / 2]
-                                         : 0.5 * (rates[rates.size() / 2 - 1] + rates[rates.size() / 2]);
-  const double best = rates.back();
+  const auto t = frostmpm::bench::time_steps(kernel, o);
   const double checksum = kernel.checksum();
-  const int total_steps = 1 + repetitions * steps;
+  const int total_steps = 1 + t.repetitions * t.steps;
 
-  if (json) {
+  if (o.json) {
     std::printf(
         "{\"particles\": %zu, \"cells\": [%d, %d], \"threads\": %d, \"steps_per_repetition\": %d, "
         "\"repetitions\": %d, \"dt\": %.6e, \"particle_steps_per_s\": %.6e, \"particle_steps_per_s_best\": %.6e, "
         "\"cpu_share\": %.3f, \"settlement\": %.6e, \"checksum\": %.17g}\n",
-        kernel.n, kernel.cells_x, kernel.cells_y, thread_count(), steps, repetitions, kernel.dt, median, best,
-        cpu_share, kernel.top_settlement(), checksum);
+        kernel.n, kernel.cells_x, kernel.cells_y, thread_count(), t.steps, t.repetitions, kernel.dt, t.median, t.best,
+        t.cpu_share, kernel.top_settlement(), checksum);
   } else {
     std::printf("elastic_kernel: explicit elastic MPM step (GIMP, USF, FLIP), %zu particles on %d x %d cells, "
                 "dt %.4g s\n",
                 kernel.n, kernel.cells_x, kernel.cells_y, kernel.dt);
-    std::printf("threads %d, %d repetitions of %d steps after one warm-up step%s\n", thread_count(), repetitions, steps,
-                repetitions < repeat ? " (cut by --max-seconds)" : "");
-    std::printf("particle-steps/s  median %.4g  best %.4g\n", median, best);
-    std::printf("CPU share of the threads while timed %.2f\n", cpu_share);
+    frostmpm::bench::print_timing(t, o);
     std::printf("top settlement after %d steps (%.4g s) %.4g m\n", total_steps, total_steps * kernel.dt,
                 kernel.top_settlement());
     std::printf("checksum %.17g\n", checksum);

@@ -111,9 +111,7 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
                                 "pressure is fixed only up to a constant: add a pore_pressure boundary condition");
 
   const std::size_t n = sim.particle_count(), nodes = sim.grid().node_count();
-  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,
-                  &mobility_})
-    v->assign(n, 0.0);
+  for (auto* v : per_particle_arrays()) v->assign(n, 0.0);
   for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
 }
 
@@ -538,9 +536,7 @@ void HydraulicPhysics::removing_particles(const ParticleRemoval& removal) {
     for (std::size_t p = 0; p < removal.leaving.size(); ++p)
       if (removal.leaving[p]) removed_water_ += vol[p] * n_l_[p];  // liquid water [m³ per m]
   }
-  for (auto* v : {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_,
-                  &mobility_})
-    removal.compact(*v);
+  for (auto* v : per_particle_arrays()) removal.compact(*v);
   material_ = material_.first(removal.remaining);  // the kernel compacts its storage in place
 }
 

@@ -20,6 +20,7 @@
 // The momentum steps run at the material points, the quadrature points of the pressure
 // equation, so K is exactly the operator the corrector applies: mass balances in every step
 // (docs/architecture.md, "Pore-water flow").
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -137,6 +138,10 @@ class HydraulicPhysics final : public Physics {
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
   std::vector<double> source_, S_prev_, T_prev_;
+  /// Every array above with one value per particle (sized at setup, compacted on removal).
+  std::array<std::vector<double>*, 12> per_particle_arrays() {
+    return {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_, &mobility_};
+  }
   bool primed_ = false;        ///< S_prev_ and T_prev_ hold a step's start
   bool temperature_ = false;   ///< a thermal physics provides the particle temperature
 

@@ -226,14 +226,17 @@ void ThermalPhysics::evaluate_particle_properties(std::size_t p, double phi, dou
   conductivity_[p] = constants_[material_[p]].conductivity(phi, std::clamp(table.saturation(T_property, h), 0.0, 1.0));
 }
 
+double ThermalPhysics::particle_heat(std::size_t p, std::span<const double> T, std::span<const double> phi,
+                                     std::span<const double> vol) const {
+  int h = hint_[p];
+  return vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
+}
+
 double ThermalPhysics::particle_heat_total() const {
   const auto T = temperature_.values();
   const auto phi = porosity_.values();
   const auto vol = volume_.values();
-  return reproducible_sum(kernel_->particle_count(), [&](std::size_t p) {
-    int h = hint_[p];
-    return vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
-  });
+  return reproducible_sum(kernel_->particle_count(), [&](std::size_t p) { return particle_heat(p, T, phi, vol); });
 }
 
 void ThermalPhysics::removing_particles(const ParticleRemoval& removal) {
@@ -243,11 +246,8 @@ void ThermalPhysics::removing_particles(const ParticleRemoval& removal) {
     const auto phi = porosity_.values();
     const auto vol = volume_.values();
     double heat = 0;
-    for (std::size_t p = 0; p < removal.leaving.size(); ++p) {
-      if (!removal.leaving[p]) continue;
-      int h = hint_[p];
-      heat += vol[p] * tables_[material_[p]]->heat(sensible(p, phi[p]), phi[p], T[p], h);
-    }
+    for (std::size_t p = 0; p < removal.leaving.size(); ++p)
+      if (removal.leaving[p]) heat += particle_heat(p, T, phi, vol);
     removed_heat_ += heat;
     if (heat_after_step_valid_) heat_after_step_ -= heat;  // not a change by deformation
   }

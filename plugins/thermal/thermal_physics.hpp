@@ -183,6 +183,9 @@ class ThermalPhysics final : public Physics {
   void map_to_particles();
   void shed_to_grid();
   void apply_particle_dirichlet(double time, bool count_heat);
+  /// V_p times the heat content of particle p at its temperature (the enthalpy table's).
+  double particle_heat(std::size_t p, std::span<const double> T, std::span<const double> phi,
+                       std::span<const double> vol) const;
   double particle_heat_total() const;
   // explicit_step.cpp
   double particle_flows(bool conduction, bool convection);

@@ -16,15 +16,38 @@ namespace {
 
 std::string roofline_exe() { return binary_dir() + "/bin/roofline"; }
 
-/// The "checksum" value of the roofline's --json line, as printed (17 digits).
-std::string roofline_checksum(int threads) {
-  const auto r = run_command(roofline_exe() + " --particles 3000 --steps 3 --repeat 1 --json --threads " +
-                             std::to_string(threads));
+/// The "checksum" value of a reference kernel's --json line (roofline, elastic_kernel), as printed (17 digits).
+std::string kernel_checksum(const std::string& exe, int steps, int threads) {
+  const auto r = run_command(exe + " --particles 3000 --steps " + std::to_string(steps) +
+                             " --repeat 1 --json --threads " + std::to_string(threads));
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
   const auto at = r.output.find("\"checksum\": ");
   REQUIRE(at != std::string::npos);
   return r.output.substr(at + 12, r.output.find('}', at) - at - 12);
+}
+
+/// A benchmark's CSV table of 30 000 particles on 1 and 2 threads: one row each, at least
+/// `min_steps` scene steps, and every column of `rates` finite and positive.
+void check_rate_table(const std::string& path, double min_steps, const std::vector<std::string>& rates) {
+  const CsvTable table = read_csv(path);
+  REQUIRE(table.rows.size() == 2);
+  std::set<double> threads;
+  for (const auto& row : table.rows) {
+    REQUIRE(row.size() == table.header.size());
+    CHECK(row[table.column("particles")] == 30000);
+    CHECK(row[table.column("cells_x")] == 150);
+    CHECK(row[table.column("cells_y")] == 50);
+    CHECK(row[table.column("steps")] >= min_steps);
+    threads.insert(row[table.column("threads")]);
+    for (const auto& name : rates) {
+      const double value = row[table.column(name)];
+      INFO(name << " = " << value);
+      CHECK(std::isfinite(value));
+      CHECK(value > 0);
+    }
+  }
+  CHECK(threads == std::set<double>{1, 2});
 }
 
 }  // namespace
@@ -43,50 +66,21 @@ TEST_CASE("bench smoke test: throughput --quick prints the table with finite pos
   CHECK(r.output.find("vs base") != std::string::npos);
   CHECK(r.output.find("roofline") != std::string::npos);
 
-  const CsvTable table = read_csv(dir.file("table.csv"));
-  REQUIRE(table.rows.size() == 2);
-  std::set<double> threads;
-  for (const auto& row : table.rows) {
-    REQUIRE(row.size() == table.header.size());
-    CHECK(row[table.column("particles")] == 30000);
-    CHECK(row[table.column("cells_x")] == 150);
-    CHECK(row[table.column("cells_y")] == 50);
-    threads.insert(row[table.column("threads")]);
-    for (const char* name : {"steps", "scene_ps_per_s", "scene_whole_run_ps_per_s", "scene_wall_s", "roofline_ps_per_s",
-                             "ratio", "scene_speedup", "roofline_speedup", "roofline_cpu_share", "baseline_ps_per_s",
-                             "vs_baseline"}) {
-      const double value = row[table.column(name)];
-      INFO(name << " = " << value);
-      CHECK(std::isfinite(value));
-      CHECK(value > 0);
-    }
-  }
-  CHECK(threads == std::set<double>{1, 2});
+  // "steps" is positive: the scene ran.
+  check_rate_table(dir.file("table.csv"), 1,
+                   {"steps", "scene_ps_per_s", "scene_whole_run_ps_per_s", "scene_wall_s", "roofline_ps_per_s", "ratio",
+                    "scene_speedup", "roofline_speedup", "roofline_cpu_share", "baseline_ps_per_s", "vs_baseline"});
 }
 
 TEST_CASE("bench smoke test: the roofline's checksum is the same on 1 and 2 threads", "[bench]") {
   // Coloured-block P2G and reproducible sums: the same answer bit for bit on any thread count.
-  CHECK(roofline_checksum(1) == roofline_checksum(2));
+  CHECK(kernel_checksum(roofline_exe(), 3, 1) == kernel_checksum(roofline_exe(), 3, 2));
 }
-
-namespace {
-
-/// The "checksum" value of elastic_kernel's --json line, as printed (17 digits).
-std::string elastic_checksum(int threads) {
-  // Enough steps for particles to change blocks (the scatter order is rebuilt), still tiny.
-  const auto r = run_command(binary_dir() + "/bin/elastic_kernel --particles 3000 --steps 40 --repeat 1 --json --threads " +
-                             std::to_string(threads));
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  const auto at = r.output.find("\"checksum\": ");
-  REQUIRE(at != std::string::npos);
-  return r.output.substr(at + 12, r.output.find('}', at) - at - 12);
-}
-
-}  // namespace
 
 TEST_CASE("bench smoke test: the elastic kernel's checksum is the same on 1 and 2 threads", "[bench]") {
-  CHECK(elastic_checksum(1) == elastic_checksum(2));
+  // Enough steps for particles to change blocks (the scatter order is rebuilt), still tiny.
+  const std::string exe = binary_dir() + "/bin/elastic_kernel";
+  CHECK(kernel_checksum(exe, 40, 1) == kernel_checksum(exe, 40, 2));
 }
 
 TEST_CASE("bench smoke test: mechanical_throughput prints the table with finite positive rates", "[bench]") {
@@ -102,25 +96,9 @@ TEST_CASE("bench smoke test: mechanical_throughput prints the table with finite 
   CHECK(r.output.find("scene p-s/s") != std::string::npos);
   CHECK(r.output.find("mechanical.predict") != std::string::npos);
   CHECK(r.output.find("vs base") != std::string::npos);
-  const CsvTable table = read_csv(dir.file("table.csv"));
-  REQUIRE(table.rows.size() == 2);
-  std::set<double> threads;
-  for (const auto& row : table.rows) {
-    REQUIRE(row.size() == table.header.size());
-    CHECK(row[table.column("particles")] == 30000);
-    CHECK(row[table.column("cells_x")] == 150);
-    CHECK(row[table.column("cells_y")] == 50);
-    CHECK(row[table.column("steps")] >= 5);
-    threads.insert(row[table.column("threads")]);
-    for (const char* name : {"scene_ps_per_s", "scene_wall_s", "kernel_ps_per_s", "ratio", "scene_speedup",
-                             "kernel_speedup", "kernel_cpu_share", "baseline_ps_per_s", "vs_baseline"}) {
-      const double value = row[table.column(name)];
-      INFO(name << " = " << value);
-      CHECK(std::isfinite(value));
-      CHECK(value > 0);
-    }
-  }
-  CHECK(threads == std::set<double>{1, 2});
+  check_rate_table(dir.file("table.csv"), 5,
+                   {"scene_ps_per_s", "scene_wall_s", "kernel_ps_per_s", "ratio", "scene_speedup", "kernel_speedup",
+                    "kernel_cpu_share", "baseline_ps_per_s", "vs_baseline"});
 }
 
 TEST_CASE("bench smoke test: throughput says to build first when frostmpm is missing", "[bench]") {

@@ -119,13 +119,6 @@ sys.exit(1 if problems else 0)
   }
 }
 
-std::string run_json(const std::string& out, const std::string& path) {
-  const auto py = run_command("/usr/bin/python3 -c \"import json; print(json.load(open('" + out + "/run.json'))" +
-                              path + ")\"");
-  REQUIRE(py.exit_code == 0);
-  return py.output.substr(0, py.output.find('\n'));
-}
-
 void run_reference(const std::string& reference) {
   const auto r = run_frostmpm("run " + scene_args() + " -o " + reference);
   INFO(r.output);

@@ -47,13 +47,6 @@ probes:
   - {name: T_max, type: max, field: temperature}
 )";
 
-std::string run_value(const std::string& out, const std::string& path) {
-  const auto py = run_command("/usr/bin/python3 -c \"import json; print(json.load(open('" + out + "/run.json'))" + path +
-                              ")\"");
-  REQUIRE(py.exit_code == 0);
-  return py.output.substr(0, py.output.find('\n'));
-}
-
 }  // namespace
 
 TEST_CASE("particles leaving the grid: a clean stop by default, or removed with their heat and mass counted",
@@ -79,8 +72,8 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
     const auto r = run_frostmpm("run " + dir.file("block.yaml") + " -o " + out);
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
-    CHECK(run_value(out, "['run']['removed_particles']") == "400");
-    CHECK(run_value(out, "['run']['particles']") == "200");
+    CHECK(run_json(out, "['run']['removed_particles']") == "400");
+    CHECK(run_json(out, "['run']['particles']") == "200");
     // Mass: 400 × V_p ρ_m, V_p = 1e-4 m², ρ_m = 0.7 · 2000 + 0.3 · 1000 (liquid water at 5 °C).
     CHECK(run_counter(out, "mechanical.mass_removed_kg") == Approx(400 * 1e-4 * 1700).epsilon(1e-9));
     // The 200 left move on at 0.25 m/s: ½ m v².
@@ -122,7 +115,7 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
     INFO(resumed.output);
     REQUIRE(resumed.exit_code == 0);
     CHECK(read_file(out + "/metrics.csv") == read_file(dir.file("reference") + "/metrics.csv"));
-    CHECK(run_value(out, "['run']['removed_particles']") == "400");
+    CHECK(run_json(out, "['run']['removed_particles']") == "400");
     CHECK(run_counter(out, "thermal.energy_removed_J") == run_counter(dir.file("reference"), "thermal.energy_removed_J"));
     CHECK(run_counter(out, "mechanical.mass_removed_kg") ==
           run_counter(dir.file("reference"), "mechanical.mass_removed_kg"));

@@ -89,6 +89,13 @@ double run_counter(const std::string& out, const std::string& key) {
   return std::stod(json.substr(at + quoted.size()));
 }
 
+std::string run_json(const std::string& out, const std::string& path) {
+  const auto py = run_command("/usr/bin/python3 -c \"import json; print(json.load(open('" + out + "/run.json'))" +
+                              path + ")\"");
+  if (py.exit_code != 0) throw std::runtime_error("run.json in " + out + ": cannot read " + path + ": " + py.output);
+  return py.output.substr(0, py.output.find('\n'));
+}
+
 CsvTable read_csv(const std::string& path) {
   CsvTable table;
   std::ifstream in(path);

@@ -57,6 +57,9 @@ CsvTable read_csv(const std::string& path);
 /// A counter of OUT/run.json's `run.counters` ("thermal.energy_balance_error_relative", ...);
 /// throws std::out_of_range naming it when absent.
 double run_counter(const std::string& out, const std::string& key);
+/// One value of OUT/run.json as Python prints it, `path` a subscript chain ("['run']['steps']"):
+/// a JSON integer prints without a decimal point.
+std::string run_json(const std::string& out, const std::string& path);
 
 /// `frostmpm ARGS` running in the background with default signal dispositions (whatever the
 /// test runner inherited), stdout into `stdout_path` and stderr into `stderr_path` (or with

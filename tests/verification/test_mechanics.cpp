@@ -27,7 +27,8 @@ std::string number(double v) {
   return out.str();
 }
 
-/// Runs configs/verification/<scene> with overrides; returns metrics.csv.
+/// Runs configs/verification/<scene> (a paper scene as "../paper/<scene>") with overrides;
+/// returns metrics.csv.
 CsvTable run_scene(const TempDir& dir, const std::string& scene, const std::vector<std::string>& sets,
                    const std::string& name) {
   std::string cmd = "run " + source_dir() + "/configs/verification/" + scene + " -o " + dir.file(name) +
@@ -399,15 +400,10 @@ TEST_CASE("rock freezing around a borehole (coarse): thermal contraction before 
   // qualitative findings (Sec. 5.2.2) as assertions.
   TempDir dir;
   auto run = [&](const std::string& name, const std::vector<std::string>& more) {
-    std::string cmd = "run " + source_dir() + "/configs/paper/rock_freezing.yaml -o " + dir.file(name) +
-                      " --set output.progress=false --set time.end=7200 --set 'grid.cells=[23, 15]' --set "
-                      "grid.cell_size=0.01 --set boundary_conditions.0.particles.disk.radius=0.028 --set "
-                      "output.metrics_every=300";
-    for (const auto& s : more) cmd += " --set '" + s + "'";
-    const auto r = run_frostmpm(cmd);
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
-    return read_csv(dir.file(name + "/metrics.csv"));
+    std::vector<std::string> sets = {"time.end=7200", "grid.cells=[23, 15]", "grid.cell_size=0.01",
+                                     "boundary_conditions.0.particles.disk.radius=0.028", "output.metrics_every=300"};
+    sets.insert(sets.end(), more.begin(), more.end());
+    return run_scene(dir, "../paper/rock_freezing.yaml", sets, name);
   };
   struct Summary {
     double contraction = 0, frozen_pressure = 0;  // min ε_rr at A while T_A > 0; max p_A once T_A < 0

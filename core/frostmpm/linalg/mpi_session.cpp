@@ -79,10 +79,13 @@ void ensure_mpi_initialized() {
     throw std::runtime_error("MPI has already been finalized; it cannot be initialized again");
   }
   static LazyMpi lazy;  // initializes on first use (thread-safe); finalizes at exit if it owns MPI
+  // Once: a launcher the environment check in main() did not know shows in the world's size.
+  static const bool one_rank = [] {
+    refuse_multiple_ranks();
+    return true;
+  }();
   (void)lazy;
-  int size = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  if (size > 1) refuse_multiple_ranks();  // a launcher the environment check did not know
+  (void)one_rank;
 }
 
 int launched_ranks() {

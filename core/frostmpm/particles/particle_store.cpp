@@ -85,24 +85,14 @@ ParticleRange ParticleStore::append(std::size_t count, int material) {
   return range;
 }
 
-void ParticleStore::remove(std::span<const std::uint8_t> leaving) {
-  if (leaving.size() != size_) throw std::invalid_argument("ParticleStore::remove: one flag per particle expected");
-  for (auto& [_, column] : fields_) {
-    const auto c = static_cast<std::size_t>(column.components);
-    std::size_t out = 0;
-    for (std::size_t p = 0; p < size_; ++p) {
-      if (leaving[p]) continue;
-      std::copy_n(column.values.begin() + static_cast<std::ptrdiff_t>(p * c), c,
-                  column.values.begin() + static_cast<std::ptrdiff_t>(out * c));
-      ++out;
-    }
-    column.values.resize(out * c);
-  }
+void ParticleStore::remove(const ParticleRemoval& removal) {
+  if (removal.leaving.size() != size_) throw std::invalid_argument("ParticleStore::remove: one flag per particle expected");
+  for (auto& [_, column] : fields_) removal.compact(column.values, static_cast<std::size_t>(column.components));
   // Each region keeps its (possibly empty) range, so range k still names regions.k.
   std::size_t kept = 0;
   for (auto& range : ranges_) {
     const std::size_t begin = kept;
-    for (std::size_t p = range.begin; p < range.end; ++p) kept += leaving[p] ? 0 : 1;
+    for (std::size_t p = range.begin; p < range.end; ++p) kept += removal.leaving[p] ? 0 : 1;
     range.begin = begin;
     range.end = kept;
   }

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "frostmpm/particles/particle_removal.hpp"
+
 namespace frostmpm {
 
 /// How the components of a particle or nodal field are laid out and named.
@@ -73,8 +75,8 @@ class ParticleStore {
   /// Appends `count` particles of `material` (fields get their initial values); returns the range.
   ParticleRange append(std::size_t count, int material);
 
-  /// Drops every particle p with leaving[p] != 0 from every field; the others keep their order.
-  void remove(std::span<const std::uint8_t> leaving);
+  /// Drops the leaving particles from every field; the others keep their order.
+  void remove(const ParticleRemoval& removal);
 
   std::size_t size() const { return size_; }
   const std::vector<ParticleRange>& ranges() const { return ranges_; }

@@ -4,16 +4,14 @@
 // owns, and the stages it hooks into the kernel's phases, each with the fields it reads and
 // writes (core/frostmpm/step/stage.hpp). Physics couple through those named fields only; the kernel
 // orders the step from the declarations and never names a physical model.
-#include <cstddef>
-#include <cstdint>
 #include <functional>
 #include <limits>
 #include <optional>
-#include <span>
 #include <string>
 #include <vector>
 
 #include "frostmpm/config/param_schema.hpp"
+#include "frostmpm/particles/particle_removal.hpp"
 #include "frostmpm/physics/kernel.hpp"
 #include "frostmpm/step/stage.hpp"
 
@@ -32,44 +30,6 @@ struct ModelSlot {
 struct PersistentArray {
   std::string name;
   std::vector<double>* values = nullptr;
-};
-
-/// Particles leaving the run (`grid.particles_leaving: remove`): `leaving[p]` is 1 for each,
-/// `new_index[p]` the index particle p keeps afterwards (-1 when it leaves). A physics counts
-/// what the leaving particles carry (its balances stay closed), then compacts its own
-/// per-particle arrays and particle lists with compact() and remap().
-struct ParticleRemoval {
-  std::span<const std::uint8_t> leaving;
-  std::vector<std::int64_t> new_index;
-  std::size_t remaining = 0;
-  bool restoring = false;  ///< a restart re-applying earlier removals: nothing to count
-
-  explicit ParticleRemoval(std::span<const std::uint8_t> leaving_particles) : leaving(leaving_particles) {
-    new_index.resize(leaving.size());
-    for (std::size_t p = 0; p < leaving.size(); ++p)
-      new_index[p] = leaving[p] ? -1 : static_cast<std::int64_t>(remaining++);
-  }
-  /// Keeps the values of every remaining particle, in order (an array of any whole number of
-  /// values per particle; one of another length, such as an empty one, is left alone).
-  template <class T>
-  void compact(std::vector<T>& values) const {
-    if (leaving.empty() || values.empty() || values.size() % leaving.size() != 0) return;
-    const std::size_t per_particle = values.size() / leaving.size();
-    std::size_t out = 0;
-    for (std::size_t p = 0; p < leaving.size(); ++p) {
-      if (leaving[p]) continue;
-      for (std::size_t c = 0; c < per_particle; ++c) values[out * per_particle + c] = values[p * per_particle + c];
-      ++out;
-    }
-    values.resize(out * per_particle);
-  }
-  /// A list of particle indices: the leaving ones dropped, the others renumbered.
-  void remap(std::vector<std::size_t>& particles) const {
-    std::size_t out = 0;
-    for (std::size_t p : particles)
-      if (!leaving[p]) particles[out++] = static_cast<std::size_t>(new_index[p]);
-    particles.resize(out);
-  }
 };
 
 class Physics {

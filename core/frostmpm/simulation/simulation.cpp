@@ -327,8 +327,8 @@ void Simulation::remove_particles(std::span<const std::uint8_t> leaving, bool re
   probes_.remove_particles(removal, time_);
   for (auto& physics : physics_) physics->removing_particles(removal);
   for (auto& bc : bcs_) removal.remap(bc.particles);
-  transfer_.remove_particles(leaving);
-  particles_.remove(leaving);
+  transfer_.remove_particles(removal);
+  particles_.remove(removal);
   positions_changed_ = true;
 }
 

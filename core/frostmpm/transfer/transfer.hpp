@@ -17,6 +17,7 @@
 
 #include "frostmpm/grid/uniform_grid.hpp"
 #include "frostmpm/parallel/parallel.hpp"
+#include "frostmpm/particles/particle_removal.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
 #include "frostmpm/transfer/coloured_blocks.hpp"
 #include "frostmpm/transfer/nodal_interpolation.hpp"
@@ -29,14 +30,9 @@ class Transfer {
   void configure(ShapeKind kind) { stencil_.configure(kind); }
   /// Material index of every particle (set once, when the particles are made).
   void set_materials(std::vector<std::uint16_t> materials) { material_ = std::move(materials); }
-  /// Drops the materials of the particles flagged in `leaving`, in place: the storage stays
-  /// where it is, so a physics' view of it stays valid (over the first remaining entries).
-  void remove_particles(std::span<const std::uint8_t> leaving) {
-    std::size_t out = 0;
-    for (std::size_t p = 0; p < leaving.size() && p < material_.size(); ++p)
-      if (!leaving[p]) material_[out++] = material_[p];
-    material_.resize(out);
-  }
+  /// Drops the materials of the leaving particles, in place: the storage stays where it is, so
+  /// a physics' view of it stays valid (over the first remaining entries).
+  void remove_particles(const ParticleRemoval& removal) { removal.compact(material_, 1); }
 
   /// Recomputes every stencil; rebuilds the coloured blocks when the topology changed.
   /// Returns the first particle whose support leaves the grid, or -1 (nothing rebuilt then).
