@@ -164,7 +164,8 @@ void refuse_earlier_results(const std::string& dir, bool overwrite, const std::s
   const bool resumable = std::find(found.begin(), found.end(), "checkpoint.h5") != found.end();
   throw InputError(dir + ": holds the results of an earlier run (" + listed + "); give another -o, add --overwrite " +
                    "to replace them" +
-                   (resumable ? ", or continue that run with: " + shell_word(program) + " run --restart " + shell_word(dir)
+                   (resumable ? ", or continue that run with: " + shell_word(program) + " run --restart " + shell_word(dir) +
+                                 " (if it finished, with --set time.end=LATER)"
                               : std::string()));
 }
 
@@ -174,10 +175,25 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
             const std::string& program) {
   const auto start = std::chrono::steady_clock::now();
   const bool restart = !restart_dir.empty();
-  if (restart && (!o.scene.empty() || !out_dir.empty() || !o.overrides.empty() || !o.plugin_paths.empty() || overwrite))
-    throw InputError("--restart OUT takes no scene, -o, --set, --plugin-path or --overwrite: the checkpoint in OUT holds them");
+  if (restart && (!o.scene.empty() || !out_dir.empty() || !o.plugin_paths.empty() || overwrite))
+    throw InputError("--restart OUT takes no scene, -o, --plugin-path or --overwrite: the checkpoint in OUT holds them");
   if (!restart && o.scene.empty()) throw InputError("give a scene file to run, or --restart OUT to continue a run");
-  const SceneSource source = restart ? CheckpointReader(restart_dir).scene() : scene_source(o);
+  SceneSource source = restart ? CheckpointReader(restart_dir).scene() : scene_source(o);
+  if (restart) {
+    // Only what may change between two parts of one run: its end and how often it writes.
+    // Anything else would make the continued run differ from the same run made in one go.
+    static const std::vector<std::string> changeable = {
+        "time.end", "output.every", "output.metrics_every", "output.progress",
+        "checkpoint.every_steps", "checkpoint.every_minutes", "checkpoint.at_end"};
+    for (const auto& assignment : o.overrides) {
+      const std::string key = assignment.substr(0, assignment.find('='));
+      if (std::find(changeable.begin(), changeable.end(), key) == changeable.end())
+        throw InputError("--set " + assignment + ": a restart may change only " + join(changeable) +
+                         "; other keys would make the continued run differ from one made in one go (start a new "
+                         "run with -o instead)");
+      source.overrides.push_back(assignment);
+    }
+  }
   auto prepared = prepare(source, restart ? source.path : o.scene);
   const std::string dir =
       restart ? restart_dir : out_dir.empty() ? "frostmpm-out/" + fs::path(o.scene).stem().string() : out_dir;
@@ -255,8 +271,9 @@ int main(int argc, char** argv) {
   bool overwrite = false;
   run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
   run->add_option("--restart", restart_dir,
-                  "continue the run in folder OUT from OUT/checkpoint.h5, appending to its outputs "
-                  "(give nothing else: the checkpoint holds the scene, overrides and plugin paths)")
+                  "continue the run in folder OUT from OUT/checkpoint.h5, appending to its outputs; the "
+                  "checkpoint holds the scene, overrides and plugin paths, and --set may change only "
+                  "time.end (extending a finished run), output and checkpoint frequencies")
       ->type_name("OUT");
   int threads = 0;
   run->add_option("--threads", threads,

@@ -19,7 +19,8 @@ const std::map<std::string, std::string> kScenes = {
     {"DC", "configs/verification/darcy_column.yaml"},    {"NF", "configs/verification/neumann_freezing.yaml"},
     {"KA", "configs/verification/kurylyk_advection.yaml"}, {"P1", "configs/paper/frozen_inclusion_case1.yaml"},
     {"SW", "configs/verification/self_weight_column.yaml"}, {"VB", "configs/verification/vibrating_bar.yaml"},
-    {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"}};
+    {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"},
+    {"RF", "configs/paper/rock_freezing.yaml"}};
 
 struct Case {
   int line = 0;

@@ -129,7 +129,7 @@ void restart_to_the_end(const std::string& out) {
   const auto r = run_frostmpm("run --restart " + out);
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
-  REQUIRE(!fs::exists(out + "/checkpoint.h5"));  // a finished run has nothing left to resume
+  REQUIRE(fs::exists(out + "/checkpoint.h5"));  // the finished run's, for extending it
   REQUIRE(!fs::exists(out + "/checkpoint.h5.partial"));
   CHECK(run_json(out, "['run']['restarts']") == "1");  // a count: a JSON integer
   CHECK(run_json(out, "['status']") == "finished");
@@ -250,13 +250,23 @@ TEST_CASE("restart without a usable checkpoint is one error line and exit 2", "[
   write_file(dir.file("garbage/checkpoint.h5"), "not an HDF5 file\n");
   require_one_line_error(run_frostmpm("run --restart " + dir.file("garbage")), "not a readable checkpoint");
 
-  // A finished run keeps no checkpoint; an HDF5 file that is not a checkpoint is refused.
+  // A finished run keeps its checkpoint, which only a later time.end continues; without
+  // checkpoint.at_end it keeps none; an HDF5 file that is not a checkpoint is refused.
   const std::string finished = dir.file("finished");
   const auto r = run_frostmpm("run " + source_dir() + "/configs/verification/neumann_thaw.yaml --set time.end=600 -o " +
                               finished + " --set 'checkpoint={every_steps: 1}'");
   INFO(r.output);
   REQUIRE(r.exit_code == 0);
-  require_one_line_error(run_frostmpm("run --restart " + finished), "no checkpoint.h5 to restart from");
+  require_one_line_error(run_frostmpm("run --restart " + finished), "finished at t = 600 s and time.end is 600 s");
+  require_one_line_error(run_frostmpm("run --restart " + finished + " --set time.end=300"), "give a later end");
+  require_one_line_error(run_frostmpm("run --restart " + finished + " --set grid.cell_size=0.01"),
+                         "a restart may change only time.end");
+  const std::string no_final = dir.file("no_final");
+  REQUIRE(run_frostmpm("run " + source_dir() + "/configs/verification/neumann_thaw.yaml --set time.end=600 -o " +
+                       no_final + " --set 'checkpoint={at_end: false}'")
+              .exit_code == 0);
+  require_one_line_error(run_frostmpm("run --restart " + no_final), "no checkpoint.h5 to restart from");
+  fs::remove(finished + "/checkpoint.h5");
   fs::copy_file(finished + "/fields.h5", finished + "/checkpoint.h5");
   require_one_line_error(run_frostmpm("run --restart " + finished), "not a readable checkpoint");
 

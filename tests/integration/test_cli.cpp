@@ -150,7 +150,7 @@ TEST_CASE("bad input: unknown model name lists the registered ones", "[cli][bad-
   TempDir dir;
   const auto r = run_bad(dir, replace(kGoodScene, "model: van_genuchten_cc", "model: van_genuchten"));
   REQUIRE(r.output.find("unknown sfcc model 'van_genuchten'") != std::string::npos);
-  REQUIRE(r.output.find("exponential, linear, power_law, van_genuchten_cc") != std::string::npos);
+  REQUIRE(r.output.find("exponential, linear, power_law, table, van_genuchten_cc") != std::string::npos);
 }
 
 TEST_CASE("bad input: a library that is not a FrostMPM plugin is refused by name", "[cli][bad-input]") {
@@ -392,4 +392,18 @@ TEST_CASE("run into a folder that holds an earlier run's results is refused with
   REQUIRE(replaced.exit_code == 0);
   REQUIRE(!fs::exists(out + "/checkpoint.h5"));
   REQUIRE(run_frostmpm("run --restart " + out + " --overwrite").exit_code == 2);
+}
+
+TEST_CASE("a model parameter named like a material constant takes the material's value", "[cli]") {
+  // The rock-freezing scene's freezing curve names neither ice_density nor latent_heat: it reads
+  // the material's, so changing the material changes the curve (one source for a constant).
+  const std::string scene = source_dir() + "/configs/paper/rock_freezing.yaml";
+  const auto r = run_frostmpm("check " + scene + " --set materials.rock.ice_density=920 --set materials.rock.latent_heat=3.3e5");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  const auto sfcc = r.output.find("model: van_genuchten_cc");
+  REQUIRE(sfcc != std::string::npos);
+  const std::string section = r.output.substr(sfcc, r.output.find("absolute_permeability", sfcc) - sfcc);
+  CHECK(section.find("ice_density: 920") != std::string::npos);
+  CHECK(section.find("latent_heat: 330000") != std::string::npos);
 }

@@ -43,7 +43,7 @@ struct SfccPoint {
   double S = 0, dT = 0, dp = 0;
 };
 
-SfccPoint eval(const SfccModel& model, double T, double p) {
+SfccPoint eval(const SfccModel& model, double T, double p = 0.0) {
   double t[1] = {T}, pl[1] = {p}, s[1] = {-1}, dT[1] = {-1}, dp[1] = {-1};
   model.evaluate(t, pl, {s, dT, dp});
   return {s[0], dT[0], dp[0]};
@@ -95,6 +95,14 @@ const std::map<std::string, std::vector<SfccCase>>& sfcc_cases() {
         // Non-integer exponent 1/(1 − λ) = 3.33 and a residual.
         {"lambda: 0.7, p0: 2.0e5, residual_saturation: 0.05", 0.05,
          [](double p) { return std::vector<double>{vgcc_freezing_point(p)}; }}}},
+      {"table",
+       {// A measured-looking curve: C1 inside (not C2: finite differences skip the points),
+        // kinks at its first and last points.
+        {"temperatures: [-5, -2, -1, -0.5, 0], saturations: [0.05, 0.1, 0.2, 0.5, 1]", 0.05,
+         [](double) { return std::vector<double>{-5.0, -2.0, -1.0, -0.5, 0.0}; }},
+        // A plateau (equal saturations) then a steep rise that a cubic spline would overshoot.
+        {"temperatures: [-8, -3, -1, -0.2], saturations: [0.02, 0.02, 0.03, 1]", 0.02,
+         [](double) { return std::vector<double>{-8.0, -3.0, -1.0, -0.2}; }}}},
   };
   return cases;
 }
@@ -394,4 +402,74 @@ TEST_CASE("every SFCC parameter set keeps the contract `frostmpm test-model` che
       INFO(entry->name << " {" << c.params << "}: " << frostmpm::join(violations, "\n"));
       CHECK(violations.empty());
     }
+}
+
+TEST_CASE("tabulated SFCC is SciPy's PCHIP between its points and honest outside them", "[sfcc][table]") {
+  const auto model = make_sfcc("table", "temperatures: [-5, -2, -1, -0.5, 0], saturations: [0.05, 0.1, 0.2, 0.5, 1]");
+  CHECK(model->freezing_point() == 0.0);
+  // scipy.interpolate.PchipInterpolator on the same points (value, derivative).
+  const double reference[][3] = {{-4.0, 0.055755755755755754, 0.01141141141141141},
+                                 {-1.5, 0.13077819198508855, 0.09534016775396087},
+                                 {-0.75, 0.3147629310344828, 0.665948275862069},
+                                 {-0.1, 0.8832000000000001, 1.134}};
+  for (const auto& r : reference) {
+    INFO("T = " << r[0]);
+    CHECK(eval(*model, r[0]).S == Approx(r[1]).epsilon(1e-13));
+    CHECK(eval(*model, r[0]).dT == Approx(r[2]).epsilon(1e-12));
+  }
+  // The points themselves, below the table (its first value) and thawed above it.
+  CHECK(eval(*model, -2.0).S == Approx(0.1).epsilon(1e-15));
+  CHECK(eval(*model, -30.0).S == 0.05);
+  CHECK(eval(*model, -30.0).dT == 0.0);
+  CHECK(eval(*model, 0.5).S == 1.0);
+
+  // No overshoot where the data jump: a plateau stays flat (a spline would dip below it).
+  const auto steep = make_sfcc("table", "temperatures: [-3, -1, 0], saturations: [0.1, 0.1, 1]");
+  CHECK(eval(*steep, -2.0).S == Approx(0.1).epsilon(1e-15));  // PCHIP: 0.1
+  CHECK(eval(*steep, -0.5).S == Approx(0.4).epsilon(1e-13));  // PCHIP: 0.4
+  for (double T = -3.0; T <= 0.0; T += 0.01) {
+    const auto point = eval(*steep, T);
+    CHECK(point.S >= 0.1 - 1e-15);
+    CHECK(point.S <= 1.0);
+  }
+}
+
+TEST_CASE("tabulated SFCC reads a CSV file next to the scene and refuses broken tables", "[sfcc][table]") {
+  frostmpm::test::TempDir dir;
+  frostmpm::test::write_file(dir.file("curve.csv"), "temperature_degC,liquid_saturation\n-5, 0.05\n-2,0.1\n"
+                                                   "# measured 2024\n-1,0.2\n-0.5,0.5\n0,1\n");
+  const auto& registry = frostmpm::test::builtin_registry();
+  const auto build = [&](const std::string& body) {
+    frostmpm::test::write_file(dir.file("scene.yaml"), "material:\n  sfcc: {model: table" + (body.empty() ? "" : ", " + body) + "}\n");
+    const auto root = frostmpm::ConfigNode::load_file(dir.file("scene.yaml"));
+    return frostmpm::read_model_section(registry, SfccModel::kKind, root.child("material").child("sfcc"))
+        .create<SfccModel>(registry);
+  };
+  const auto from_file = build("file: curve.csv");  // relative to the scene's folder
+  const auto inline_table =
+      make_sfcc("table", "temperatures: [-5, -2, -1, -0.5, 0], saturations: [0.05, 0.1, 0.2, 0.5, 1]");
+  for (const double T : {-4.0, -1.5, -0.75, -0.1}) CHECK(eval(*from_file, T).S == eval(*inline_table, T).S);
+
+  const auto refused = [&](const std::string& body, const std::string& text) {
+    INFO(body);
+    try {
+      build(body);
+      FAIL("accepted");
+    } catch (const frostmpm::InputError& e) {
+      INFO(e.what());
+      CHECK(std::string(e.what()).find(text) != std::string::npos);
+      CHECK(std::string(e.what()).find("material.sfcc") != std::string::npos);
+    }
+  };
+  refused("temperatures: [-1, 0], saturations: [0.5, 1], file: curve.csv", "not both");
+  refused("", "not neither");
+  refused("temperatures: [-1, 0, 1], saturations: [0.5, 1]", "3 temperatures but 2 saturations");
+  refused("temperatures: [0, -1], saturations: [0.5, 1]", "increase strictly");
+  refused("temperatures: [-2, -1, 0], saturations: [0.5, 0.3, 1]", "decreases on warming");
+  refused("temperatures: [-1, 0], saturations: [0.5, 0.9]", "must reach 1");
+  refused("temperatures: [-1, 0], saturations: [-0.5, 1]", "outside [0, 1]");
+  refused("temperatures: [0], saturations: [1]", "at least 2 points");
+  refused("file: missing.csv", "cannot read");
+  frostmpm::test::write_file(dir.file("bad.csv"), "T,S\n-1,0.5\n0,one\n");
+  refused("file: bad.csv", "bad.csv:3");
 }

@@ -37,6 +37,7 @@ struct Probes::Probe {
   std::vector<std::size_t> particles;  ///< followed material points (displacement, settlement)
   std::vector<double> start;           ///< their initial coordinate along `component`
   std::string boundary;                ///< reaction: the boundary condition's name
+  std::string over_time;               ///< "max"/"min": the extreme over the rows so far, else empty
 };
 
 void Probes::remove_particles(const ParticleRemoval& removal, double time) {
@@ -97,8 +98,8 @@ void Probes::read(const ConfigNode* node, Sources sources) {
   sources_ = std::move(sources);
   resolved_ = YAML::Node(YAML::NodeType::Sequence);
   if (!node) return;
-  static const std::vector<std::string> types = {"min",          "max",        "value_at", "integral", "isotherm",
-                                                 "displacement", "settlement", "reaction"};
+  static const std::vector<std::string> types = {"min",          "max",        "value_at", "integral",  "isotherm",
+                                                 "thaw_depth",   "displacement", "settlement", "reaction"};
   const auto scalars = scalar_names();
   const auto& grid = *sources_.grid;
   const auto positions = sources_.particles->field("position");
@@ -138,6 +139,12 @@ void Probes::read(const ConfigNode* node, Sources sources) {
     if (const auto [it, fresh] = first_use.emplace(probe->name, name.where()); !fresh)
       throw name.error("probe name '" + probe->name + "' is used twice (first at " + it->second.describe() +
                        "); metrics.csv needs one column per name");
+    if (auto over_time = item.optional_child("over_time")) {
+      probe->over_time = over_time->as_string();
+      if (probe->over_time != "max" && probe->over_time != "min")
+        throw over_time->error("unknown over_time '" + probe->over_time +
+                               "'; valid: max, min (the extreme of the probe over the rows written so far)");
+    }
     if (probe->type == "integral") {
       for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
       if (auto scale = item.optional_child("scale")) {
@@ -146,7 +153,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       } else {
         probe->value = 1.0;
       }
-      item.finish({"type", "name", "fields", "scale"});
+      item.finish({"type", "name", "over_time", "fields", "scale"});
     } else if (probe->type == "displacement") {
       const ConfigNode at = item.child("point");
       probe->point = read_inside(at);
@@ -161,7 +168,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       }
       probe->particles = {best};
       probe->start = {positions[best * kDim + probe->component]};
-      item.finish({"type", "name", "point", "component"});
+      item.finish({"type", "name", "over_time", "point", "component"});
     } else if (probe->type == "settlement") {
       double x_lo = -std::numeric_limits<double>::infinity(), x_hi = std::numeric_limits<double>::infinity();
       if (auto range = item.optional_child("x_range")) {
@@ -188,7 +195,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         probe->particles.push_back(p);
         probe->start.push_back(positions[p * kDim + kDim - 1] + half[p * kDim + kDim - 1]);
       }
-      item.finish({"type", "name", "x_range"});
+      item.finish({"type", "name", "over_time", "x_range"});
     } else if (probe->type == "reaction") {
       const ConfigNode boundary = item.child("boundary");
       probe->boundary = boundary.as_string();
@@ -209,24 +216,74 @@ void Probes::read(const ConfigNode* node, Sources sources) {
                                             : "those of type " + join(types, ", ") + " do"));
       }
       probe->component = read_component(item.child("component"), kDim);
-      item.finish({"type", "name", "boundary", "component"});
+      item.finish({"type", "name", "over_time", "boundary", "component"});
+    } else if (probe->type == "thaw_depth") {
+      if (std::find(scalars.begin(), scalars.end(), "liquid_saturation") == scalars.end())
+        throw type.error("a thaw_depth probe reads liquid_saturation, which only the thermal physics has; add "
+                         "physics.thermal, or use an isotherm probe of another field");
+      probe->field = "liquid_saturation";
+      probe->value = 0.5;
+      if (auto level = item.optional_child("saturation")) {
+        probe->value = level->as_real();
+        if (!(probe->value > 0 && probe->value < 1))
+          throw level->error("the liquid saturation that separates thawed from frozen must lie in (0, 1)");
+      }
+      probe->from = read_inside(item.child("from"));
+      probe->to = read_inside(item.child("to"));
+      if (probe->from == probe->to) throw item.child("to").error("'to' is the same point as 'from'");
+      item.finish({"type", "name", "over_time", "saturation", "from", "to"});
     } else {
       probe->field = check_field(item.child("field"));
       if (probe->type == "value_at") {
         probe->point = read_inside(item.child("point"));
-        item.finish({"type", "name", "field", "point"});
+        item.finish({"type", "name", "over_time", "field", "point"});
       } else if (probe->type == "isotherm") {
         probe->value = item.child("value").as_real();
         probe->from = read_inside(item.child("from"));
         probe->to = read_inside(item.child("to"));
-        item.finish({"type", "name", "field", "value", "from", "to"});
+        item.finish({"type", "name", "over_time", "field", "value", "from", "to"});
       } else {
-        item.finish({"type", "name", "field"});
+        item.finish({"type", "name", "over_time", "field"});
       }
     }
     resolved_.push_back(YAML::Clone(item.raw()));
     probes_.push_back(std::move(probe));
   }
+  extremes_.assign(probes_.size(), std::numeric_limits<double>::quiet_NaN());
+}
+
+std::vector<double> Probes::record() {
+  std::vector<double> values = evaluate();
+  for (std::size_t i = 0; i < probes_.size(); ++i) {
+    const std::string& over_time = probes_[i]->over_time;
+    if (over_time.empty()) continue;
+    // A NaN row (no front along the line yet) leaves the extreme as it was.
+    if (std::isnan(extremes_[i])) extremes_[i] = values[i];
+    else if (!std::isnan(values[i]))
+      extremes_[i] = over_time == "max" ? std::max(extremes_[i], values[i]) : std::min(extremes_[i], values[i]);
+    values[i] = extremes_[i];
+  }
+  return values;
+}
+
+std::vector<PersistentArray> Probes::persistent_state() {
+  const bool any = std::any_of(probes_.begin(), probes_.end(), [](const auto& p) { return !p->over_time.empty(); });
+  if (!any) return {};
+  return {{"running_extremes", &extremes_}};
+}
+
+std::vector<double> Probes::sample_line(const Probe& probe) const {
+  const double length = std::hypot(probe.to[0] - probe.from[0], probe.to[1] - probe.from[1]);
+  const int samples = std::max(2, static_cast<int>(std::ceil(4 * length / sources_.grid->min_spacing())));
+  std::vector<double> values(static_cast<std::size_t>(samples) + 1);
+  for (int s = 0; s <= samples; ++s) {
+    const double f = double(s) / samples;
+    values[static_cast<std::size_t>(s)] =
+        sample_field(probe.field, {probe.from[0] + f * (probe.to[0] - probe.from[0]),
+                                   probe.from[1] + f * (probe.to[1] - probe.from[1])}) -
+        probe.value;
+  }
+  return values;
 }
 
 const std::vector<std::string>& Probes::leading_columns() {
@@ -319,21 +376,32 @@ std::vector<double> Probes::evaluate() const {
       out.push_back(sum / double(probe->particles.size()));
     } else if (probe->type == "reaction") {
       out.push_back(sources_.reaction(probe->boundary)[probe->component]);
-    } else {  // isotherm: distance from `from` to the first crossing of `value` along the line
+    } else {
+      // isotherm: distance from `from` to the first crossing of `value` along the line.
+      // thaw_depth: to the last place where thawed material (S_l ≥ level) lies over frozen —
+      // the bottom of the thawed layer even once the surface refreezes; 0 when nothing along
+      // the line is thawed, the line's length when it is thawed to its end.
+      const auto v = sample_line(*probe);
       const double length = std::hypot(probe->to[0] - probe->from[0], probe->to[1] - probe->from[1]);
-      const int samples = std::max(2, static_cast<int>(std::ceil(4 * length / sources_.grid->min_spacing())));
-      double previous = 0, crossing = std::numeric_limits<double>::quiet_NaN();
-      for (int s = 0; s <= samples; ++s) {
-        const double f = double(s) / samples;
-        const double v = sample_field(probe->field, {probe->from[0] + f * (probe->to[0] - probe->from[0]),
-                                                     probe->from[1] + f * (probe->to[1] - probe->from[1])}) -
-                         probe->value;
-        if (s > 0 && (previous > 0) != (v > 0)) {
-          const double f0 = double(s - 1) / samples;
-          crossing = (f0 + (f - f0) * previous / (previous - v)) * length;
-          break;
-        }
-        previous = v;
+      const std::size_t last = v.size() - 1;
+      const auto at_crossing = [&](std::size_t s) {  // between samples s − 1 and s
+        const double f0 = double(s - 1) / double(last), f = double(s) / double(last);
+        return (f0 + (f - f0) * v[s - 1] / (v[s - 1] - v[s])) * length;
+      };
+      double crossing = std::numeric_limits<double>::quiet_NaN();
+      if (probe->type == "isotherm") {
+        for (std::size_t s = 1; s <= last; ++s)
+          if ((v[s - 1] > 0) != (v[s] > 0)) {
+            crossing = at_crossing(s);
+            break;
+          }
+      } else {
+        crossing = v[last] >= 0 ? length : 0.0;
+        for (std::size_t s = last; s >= 1 && v[last] < 0; --s)
+          if (v[s - 1] >= 0 && v[s] < 0) {
+            crossing = at_crossing(s);
+            break;
+          }
       }
       out.push_back(crossing);
     }

@@ -4,6 +4,10 @@
 //   value_at         a particle field interpolated to a point through the grid (volume-weighted)
 //   integral         Σ V_p Π fields × scale
 //   isotherm         distance along a segment to the first crossing of a level
+//   thaw_depth       distance along a segment to the bottom of the thawed layer: the last place
+//                    where liquid saturation ≥ level (½ by default) lies over frozen material
+// Any probe with `over_time: max|min` reports its extreme over the rows written so far (the
+// active-layer thickness is the thaw depth's maximum); the running extreme is checkpointed.
 //   displacement     one component of the displacement of the material point that started
 //                    nearest to `point` (it is followed as it moves)
 //   settlement       mean downward displacement of the material's top surface (the top of the GIMP
@@ -54,8 +58,13 @@ class Probes {
 
   /// Reads the `probes:` list (none when `node` is null); particle positions are the initial ones.
   void read(const ConfigNode* node, Sources sources);
-  /// One value per probe, in order.
+  /// One value per probe, in order, as they are now.
   std::vector<double> evaluate() const;
+  /// The values of one metrics row: evaluate(), with `over_time` probes folded into their
+  /// running extremes.
+  std::vector<double> record();
+  /// The running extremes, for checkpoints (empty when no probe has `over_time`).
+  std::vector<PersistentArray> persistent_state();
   /// Particles left the run: the probes that follow material points follow the remaining ones.
   /// Throws NumericalBlowUp (at `time`) when a probe's every point left, unless `restoring`.
   void remove_particles(const ParticleRemoval& removal, double time);
@@ -80,8 +89,12 @@ class Probes {
   /// Every scalar name a probe may use: scalar fields and the components of the others.
   std::vector<std::string> scalar_names() const;
 
+  /// The probe's field minus its level at evenly spaced points from `from` to `to` (4 per cell).
+  std::vector<double> sample_line(const Probe& probe) const;
+
   Sources sources_;
   std::vector<std::unique_ptr<Probe>> probes_;
+  std::vector<double> extremes_;  ///< running extreme of each `over_time` probe (NaN: none yet)
   YAML::Node resolved_;
 };
 

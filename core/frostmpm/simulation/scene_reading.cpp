@@ -30,6 +30,38 @@ std::string spec_text(const ParamSpec& s) {
   return "[" + s.unit + "] default " + s.default_text() + (s.range_text().empty() ? "" : " range " + s.range_text());
 }
 
+/// A model parameter named like a material constant (ice_density, latent_heat, ...) is that
+/// constant: one source, so a freezing curve cannot silently keep 917 kg/m³ while the heat
+/// balance uses the material's 920. Left out of the model section it takes the material's value;
+/// given there with another value it is an error naming both places. Same name and same unit
+/// make a shared constant.
+void take_material_constants(ModelSection& model, const ConfigNode& model_node, const ParamSet& material,
+                             const ParamSchema& material_schema) {
+  for (const auto& spec : model.entry->schema.params()) {
+    const ParamSpec* constant = material_schema.find(spec.name);
+    // Another unit is another quantity that happens to share the symbol (the earth-pressure
+    // coefficient k0 [-] of a material and the conductivity k0 [m/s] of a permeability model).
+    if (!constant || spec.type != ParamType::Real || constant->type != ParamType::Real || spec.unit != constant->unit)
+      continue;
+    const std::string owner = model.entry->kind + " model '" + model.entry->name + "'";
+    const double shared = material.real(spec.name);
+    if (model_node.has(spec.name)) {
+      const double own = model.params.real(spec.name);
+      if (own != shared)
+        throw model_node.child(spec.name).error(
+            owner + " sets " + spec.name + " = " + number_text(own) + " but its material has " + spec.name + " = " +
+            number_text(shared) + " (" + material.where(spec.name).describe() +
+            "): a model reads its material's constants; remove it here or make the two agree");
+      continue;
+    }
+    if (!spec.in_range(shared))
+      throw InputError(material.where(spec.name),
+                       "the material's " + spec.name + " = " + number_text(shared) + " is outside the range " +
+                           spec.range_text() + " that " + owner + " accepts");
+    model.params.set(spec.name, shared, material.where(spec.name));
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> Simulation::sections() {
@@ -180,6 +212,7 @@ void Simulation::read_materials(const ConfigNode& node) {
         continue;
       }
       auto model = read_model_section(registry_, slot.kind, section.child(slot.key));
+      take_material_constants(model, section.child(slot.key), material.params, merged);
       out[slot.key] = model.resolved();
       material.models.emplace(slot.key, std::move(model));
     }
@@ -398,9 +431,13 @@ void Simulation::read_checkpoint(const ConfigNode& node) {
   ParamSchema s;
   s.integer("every_steps", "steps between checkpoints (OUT/checkpoint.h5); 0 = off").defaults_to(0L).at_least(0);
   s.real("every_minutes", "min", "wall-clock minutes between checkpoints; 0 = off").defaults_to(30.0).at_least(0);
+  s.boolean("at_end",
+            "keep a checkpoint of the finished run, so that `run --restart OUT --set time.end=LATER` can extend it")
+      .defaults_to(true);
   const ParamSet p = parse_params(s, node);
   checkpoint_every_steps_ = p.integer("every_steps");
   checkpoint_every_minutes_ = p.real("every_minutes");
+  checkpoint_at_end_ = p.boolean("at_end");
   resolved_["checkpoint"] = p.to_yaml();
 }
 

@@ -27,6 +27,8 @@ using Clock = std::chrono::steady_clock;
 /// Checkpoint group of the nodal fields the kernel carries between steps (no physics key
 /// starts with an underscore).
 constexpr const char* kCarriedNodeFields = "_carried_node_fields";
+/// Checkpoint group of the probes' running extremes (`over_time`).
+constexpr const char* kProbeState = "_probes";
 
 /// The deformation gradient a mechanics physics keeps (3×3, row-major); when the scene has it,
 /// the kernel derives particle volumes and GIMP domains from it.
@@ -487,6 +489,8 @@ void Simulation::save_checkpoint(const std::string& dir, LoopState& loop, const 
     checkpoint.write_physics(physics_keys_[i], physics_[i]->persistent_state());
   if (const auto carried = carried_node_fields(); !carried.empty())
     checkpoint.write_physics(kCarriedNodeFields, carried);
+  if (const auto extremes = probes_.persistent_state(); !extremes.empty())
+    checkpoint.write_physics(kProbeState, extremes);
   checkpoint.commit();
   for (auto& physics : physics_) physics->checkpoint_written();
   stats_.stage_seconds["kernel.checkpoint"] += std::chrono::duration<double>(Clock::now() - start).count();
@@ -509,6 +513,8 @@ LoopState Simulation::restore_checkpoint(const std::string& dir) {
     checkpoint.read_physics(physics_keys_[i], physics_[i]->persistent_state());
   if (const auto carried = carried_node_fields(); !carried.empty())
     checkpoint.read_physics(kCarriedNodeFields, carried);
+  if (const auto extremes = probes_.persistent_state(); !extremes.empty())
+    checkpoint.read_physics(kProbeState, extremes);
   if (removed) {  // stencils for the particles that remain, before the physics rebuild their state
     update_stencil();
     positions_changed_ = moving_;
@@ -577,11 +583,22 @@ void Simulation::initialize_state() {
 void Simulation::run(const OutputDir& out, const RunOptions& options) {
   // The constructor built the initial state (initialize_state).
   LoopState loop;
+  const double eps = 1e-9 * end_time_;
   if (options.restart) {
     loop = restore_checkpoint(out.path());
     // Moving particles: the stencil of the restored positions and domains, as the step after
     // the checkpoint would have made it.
     positions_changed_ = moving_;
+    if (time_ >= end_time_ - eps)
+      throw InputError(out.path() + ": the run " + (loop.next_dt == 0 ? "finished" : "was checkpointed") + " at t = " +
+                       number_text(time_) + " s and time.end is " + number_text(end_time_) +
+                       " s; to extend it, give a later end: run --restart " + out.path() + " --set time.end=SECONDS");
+    if (loop.next_dt == 0) {  // the checkpoint of a finished run: go on as if time.end had been later
+      const auto next_multiple = [&](double every) { return (std::floor(time_ / every + 1e-9) + 1) * every; };
+      loop.next_output = output_every_ > 0 ? std::min(next_multiple(output_every_), end_time_) : end_time_;
+      if (metrics_every_ > 0 && loop.next_metrics <= time_ + eps) loop.next_metrics = next_multiple(metrics_every_);
+      loop.next_dt = plan_step(loop);
+    }
   } else {
     remove_checkpoint(out.path());  // an earlier run's checkpoint would not match these outputs
     loop.next_output = output_every_ > 0 ? std::min(output_every_, end_time_) : end_time_;
@@ -604,12 +621,11 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   auto write_metrics = [&] {
     std::ostringstream row;
     row << std::setprecision(12) << time_ << ',' << step_ << ',' << dt_;
-    for (double v : probes_.evaluate()) row << ',' << v;
+    for (double v : probes_.record()) row << ',' << v;
     row << '\n';
     metrics.write(row.str(), at_step(step_, time_));  // a whole row or an error, never half a row
   };
 
-  const double eps = 1e-9 * end_time_;
   if (!options.restart) {
     write_frame();
     write_metrics();
@@ -673,7 +689,12 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
     }
     if (signal) throw RunInterrupted(signal, time_, step_);
   }
-  remove_checkpoint(out.path());  // the run is complete: nothing left to resume
+  if (checkpoint_at_end_) {
+    loop.next_dt = 0;  // marks the checkpoint of a finished run: a restart extends it with a later time.end
+    save_checkpoint(out.path(), loop, options.scene);
+  } else {
+    remove_checkpoint(out.path());  // nothing left to resume
+  }
 }
 
 }  // namespace frostmpm

@@ -199,6 +199,7 @@ class Simulation final : public Kernel<kDim> {
   long step_ = 0, restarts_ = 0;
   long checkpoint_every_steps_ = 0;
   double checkpoint_every_minutes_ = 0;
+  bool checkpoint_at_end_ = true;
   bool positions_changed_ = true;
   bool moving_ = false;
   std::size_t initial_particles_ = 0;  ///< as the scene made them
