@@ -90,7 +90,7 @@ TEST_CASE("an unknown model names the registered ones and the plugin folders sea
   INFO(r.output);
   REQUIRE(r.exit_code == 2);
   CHECK(has(r.output, "unknown sfcc model 'painter_karra'"));
-  CHECK(has(r.output, "Registered: exponential, linear, power_law, van_genuchten_cc"));
+  CHECK(has(r.output, "Registered: exponential, linear, power_law, table, van_genuchten_cc"));
   CHECK(has(r.output, "Plugin folders searched: " + fs::weakly_canonical(binary_dir() + "/lib/frostmpm/plugins").string()));
 }
 
@@ -111,8 +111,12 @@ TEST_CASE("test-model: every shipped SFCC, permeability and mechanical model kee
   int checked = 0;
   for (const std::string kind : {"sfcc", "relative_permeability", "absolute_permeability", "mechanical_model"})
     for (const auto* entry : registry.entries(kind)) {
-      // Required parameters are picked inside their ranges; linear's mushy_end has no range.
-      const std::string extra = entry->name == "linear" ? " --set mushy_end=-1" : "";
+      // Required parameters are picked inside their ranges; linear's mushy_end has no range, and
+      // a table has no default points.
+      const std::string extra =
+          entry->name == "linear"  ? " --set mushy_end=-1"
+          : entry->name == "table" ? " --set 'temperatures=[-5, -2, -1, -0.5, 0]' --set 'saturations=[0.05, 0.1, 0.2, 0.5, 1]'"
+                                   : "";
       const auto r = run_frostmpm("test-model " + kind + "/" + entry->name + extra);
       INFO(r.output);
       CHECK(r.exit_code == 0);

@@ -205,6 +205,58 @@ std::vector<PersistentArray> Simulation::carried_node_fields() {
   return arrays;
 }
 
+namespace {
+/// `{table: [[c0, v0], [c1, v1], ...], along: y}` (a coordinate) or `{table: [[d0, v0], ...],
+/// depth_below: Y}` (depth d = Y − y, a borehole log): linear between the rows, the end values
+/// beyond them. Calls set(p, value) for every particle of the range.
+template <class Set>
+void assign_profile(const ConfigNode& node, const ParticleRange& range, std::span<const double> pos, int dim,
+                    Set&& set) {
+  const ConfigNode table = node.child("table");
+  std::vector<double> at, values;
+  for (const auto& row : table.elements()) {
+    const auto pair = row.as_reals();
+    if (pair.size() != 2 || !std::isfinite(pair[0]) || !std::isfinite(pair[1]))
+      throw row.error("expected a row [coordinate, value] of two finite numbers");
+    if (!at.empty() && !(pair[0] > at.back()))
+      throw row.error("the table's coordinates must increase strictly (" + number_text(at.back()) + " then " +
+                      number_text(pair[0]) + ")");
+    at.push_back(pair[0]);
+    values.push_back(pair[1]);
+  }
+  if (at.size() < 2) throw table.error("a profile table needs at least 2 rows [coordinate, value]");
+  const bool by_depth = node.has("depth_below");
+  if (by_depth == node.has("along"))
+    throw node.error("give the table's coordinate: along: x|y" + std::string(dim == 3 ? "|z" : "") +
+                     ", or depth_below: Y (rows [depth, value], depth = Y − " + std::string(1, "xyz"[dim - 1]) + ")");
+  int axis = dim - 1;
+  double surface = 0;
+  if (by_depth) {
+    surface = node.child("depth_below").as_real();
+  } else {
+    const ConfigNode along = node.child("along");
+    const std::string name = along.as_string();
+    axis = static_cast<int>(std::string("xyz").substr(0, static_cast<std::size_t>(dim)).find(name));
+    if (name.size() != 1 || axis < 0)
+      throw along.error("unknown coordinate '" + name + "'; valid: x, y" + std::string(dim == 3 ? ", z" : ""));
+  }
+  node.finish({"table", "along", "depth_below"});
+  for (std::size_t p = range.begin; p < range.end; ++p) {
+    const double x = pos[p * std::size_t(dim) + std::size_t(axis)];
+    const double c = by_depth ? surface - x : x;
+    const auto upper = std::upper_bound(at.begin(), at.end(), c);
+    double value;
+    if (upper == at.begin()) value = values.front();
+    else if (upper == at.end()) value = values.back();
+    else {
+      const std::size_t i = static_cast<std::size_t>(upper - at.begin());
+      value = values[i - 1] + (values[i] - values[i - 1]) * (c - at[i - 1]) / (at[i] - at[i - 1]);
+    }
+    set(p, value);
+  }
+}
+}  // namespace
+
 /// Regions' `initial:` values: a state field, or one component of a vector state field
 /// ("solid_velocity.x"), set to a number or to an expression of the position,
 /// {expression: "0.1*sin(pi*x/50)"} with variables x, y.
@@ -255,6 +307,39 @@ void Simulation::apply_initial_values() {
             throw value_node.error("the value " + number_text(value) + " " + why);
           for (std::size_t p = init.range.begin; p < init.range.end; ++p)
             std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          return;
+        }
+        if (value_node.has("table")) {
+          assign_profile(value_node, init.range, pos, kDim, [&](std::size_t p, double value) {
+            if (const auto why = problem(value); !why.empty())
+              throw value_node.child("table").error("the value " + number_text(value) + " " + why);
+            std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          });
+          return;
+        }
+        if (value_node.has("hydrostatic")) {
+          if (field != "pore_pressure")
+            throw value_node.child("hydrostatic").error("hydrostatic sets pore_pressure only, not '" + key + "'");
+          const ConfigNode h = value_node.child("hydrostatic");
+          const double level = h.child("water_table").as_real();
+          h.finish({"water_table"});
+          value_node.finish({"hydrostatic"});
+          const double g = std::hypot(gravity_[0], gravity_[1]);
+          if (g == 0)
+            throw h.error("hydrostatic pressure needs gravity, and the scene's gravity is zero; give "
+                          "{expression: \"rho*g*(h - y)\"} instead");
+          const Material& material = materials_[init.range.material];
+          if (!material.params.has("water_density"))
+            throw h.error("hydrostatic pressure needs the material's water_density (a hydraulic material)");
+          // p = ρ_l g (h − y): the convention of the hydrostatic pore_pressure boundary.
+          const double rho_g = material.params.real("water_density") * g;
+          for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
+            const double value = rho_g * (level - pos[p * kDim + kDim - 1]);
+            if (const auto why = problem(value); !why.empty())
+              throw h.error("at y = " + number_text(pos[p * kDim + kDim - 1], 6) + " the hydrostatic pressure " +
+                            number_text(value) + " " + why);
+            column[p * c + k] = value;
+          }
           return;
         }
         const ConfigNode text = value_node.child("expression");
