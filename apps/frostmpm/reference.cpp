@@ -79,13 +79,22 @@ int cmd_describe(const std::string& target, bool markdown, const std::vector<std
   const Registry& registry = loaded.registry;
   std::vector<const RegistryEntry*> selected;
   const auto slash = target.find('/');
+  // A kind nobody registered is a typo or a scene section, not a missing plugin: say which.
+  if (const std::string kind = target.substr(0, slash); target != "all" && registry.entries(kind).empty()) {
+    const auto kinds = registry.kinds();
+    static const std::vector<std::string> kernel_sections = {"grid",    "time",   "gravity", "regions",   "materials",
+                                                             "output", "probes", "checkpoint", "boundary_conditions"};
+    if (std::find(kernel_sections.begin(), kernel_sections.end(), kind) != kernel_sections.end())
+      throw InputError("describe: '" + kind + "' is a scene section the kernel reads, not a plugin kind: "
+                       "docs/config-reference.md lists its keys, and `frostmpm check SCENE` prints them with their "
+                       "defaults. Plugin kinds: " + join(kinds));
+    throw InputError("describe: unknown kind '" + kind + "'" + did_you_mean(kind, kinds) + " Kinds: " + join(kinds));
+  }
   if (target == "all") {
     for (const auto& kind : registry.kinds())
       for (const auto* e : registry.entries(kind)) selected.push_back(e);
   } else if (slash == std::string::npos) {
     selected = registry.entries(target);
-    if (selected.empty())
-      throw InputError("describe: unknown kind '" + target + "'. Kinds: " + join(registry.kinds()));
   } else {
     selected.push_back(&registry.get(target.substr(0, slash), target.substr(slash + 1), {"describe", "", 0, 0}));
   }

@@ -407,3 +407,16 @@ TEST_CASE("a model parameter named like a material constant takes the material's
   CHECK(section.find("ice_density: 920") != std::string::npos);
   CHECK(section.find("latent_heat: 330000") != std::string::npos);
 }
+
+TEST_CASE("describe: a mistyped kind gets a suggestion, a kernel section says where its keys are", "[cli][bad-input]") {
+  auto r = run_frostmpm("describe sfc/x");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("unknown kind 'sfc'; did you mean 'sfcc'?") != std::string::npos);
+  CHECK(r.output.find("plugin path") == std::string::npos);  // not blamed on the plugin folders
+  r = run_frostmpm("describe grid");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("'grid' is a scene section the kernel reads") != std::string::npos);
+  CHECK(r.output.find("docs/config-reference.md") != std::string::npos);
+}
