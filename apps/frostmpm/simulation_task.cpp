@@ -16,7 +16,10 @@ class SimulationTask final : public Task {
 
   std::vector<std::string> sections() const override { return Simulation::sections(); }
   YAML::Node resolved() const override { return sim_.resolved(); }
-  std::string step_description() const override { return sim_.step_plan().describe(); }
+  std::string step_description() const override {
+    return sim_.step_plan().describe() +
+           (sim_.boundary_report().empty() ? "" : "boundary conditions at the start:\n" + sim_.boundary_report());
+  }
   void execute(const OutputDir& out, const RunRequest& request) override {
     RunOptions options;
     options.progress = sim_.resolved()["output"]["progress"].as<bool>();

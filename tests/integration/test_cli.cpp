@@ -420,3 +420,12 @@ TEST_CASE("describe: a mistyped kind gets a suggestion, a kernel section says wh
   CHECK(r.output.find("'grid' is a scene section the kernel reads") != std::string::npos);
   CHECK(r.output.find("docs/config-reference.md") != std::string::npos);
 }
+
+TEST_CASE("check reports how many of each condition's nodes carry material", "[cli]") {
+  const auto r = run_frostmpm("check " + source_dir() + "/configs/verification/neumann_freezing.yaml");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.output.find("# temperature condition 'boundary_conditions.0' on face y_max: 2 of 2 nodes carry material") !=
+        std::string::npos);
+  // A condition that reaches no material is refused: the corpus has those cases.
+}

@@ -81,6 +81,49 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   const auto checkpoint = root.optional_child("checkpoint");
   read_checkpoint(checkpoint ? *checkpoint : ConfigNode(YAML::Node(YAML::NodeType::Map), root.file(), "checkpoint"));
   initialize_state();
+  check_boundary_reach();
+}
+
+/// A condition on nodes acts through the material its nodes carry: on a face the material does
+/// not reach (a grid taller than the soil, as is usual in MPM) it would change nothing and the
+/// run would "finish" with no thaw. Refused when nothing moves; when the skeleton moves the
+/// material may arrive later, so it is a warning. `check` reports every condition's reach.
+void Simulation::check_boundary_reach() {
+  std::vector<std::uint8_t> reached(grid_.node_count(), 0);
+  const auto& stencil = transfer_.stencil();
+  const int K = stencil.per_particle();
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const auto* nodes = stencil.nodes(p);
+    const auto* w = stencil.weights(p);
+    for (int k = 0; k < K; ++k)
+      if (w[k] > 0) reached[nodes[k]] = 1;
+  }
+  // The material's extent, for the message: the union of the particle domains.
+  const auto pos = particles_.field("position"), half = particles_.field("half_size");
+  std::array<double, kDim> lo, hi;
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    for (int d = 0; d < kDim; ++d) {
+      lo[d] = std::min(lo[d], pos[p * kDim + d] - half[p * kDim + d]);
+      hi[d] = std::max(hi[d], pos[p * kDim + d] + half[p * kDim + d]);
+    }
+  std::ostringstream report;
+  for (const auto& bc : bcs_) {
+    if (bc.on_particles) continue;
+    const auto count = std::count_if(bc.nodes.begin(), bc.nodes.end(), [&](std::size_t n) { return reached[n] != 0; });
+    report << bc.label() << ": " << count << " of " << bc.nodes.size() << " nodes carry material\n";
+    if (count > 0) continue;
+    const std::string message = bc.label() + " acts on " + std::to_string(bc.nodes.size()) +
+                                " node(s), none of which the material reaches (it spans x in [" + number_text(lo[0], 6) +
+                                ", " + number_text(hi[0], 6) + "], y in [" + number_text(lo[1], 6) + ", " +
+                                number_text(hi[1], 6) + "] m), so it would change nothing";
+    if (!moving_)
+      throw bc.node->error(message + "; put it where the material is (a face the material touches, or nodes: {box: ...} "
+                                     "at its surface)");
+    log::warning(bc.node->where().describe() + ": " + message + " until material moves there");
+  }
+  boundary_report_ = report.str();
 }
 
 Simulation::~Simulation() = default;

@@ -110,6 +110,8 @@ class Simulation final : public Kernel<kDim> {
   const NodeFields& node_fields() const { return node_fields_; }
   /// The resolved step: stages in order, with their phases, reads and writes.
   const StepPlan& step_plan() const { return plan_; }
+  /// One line per boundary condition on nodes: how many of its nodes carry material at the start.
+  const std::string& boundary_report() const { return boundary_report_; }
   const StepStatistics& statistics() const { return stats_; }
   /// How often this run was restarted from a checkpoint.
   long restarts() const { return restarts_; }
@@ -200,6 +202,8 @@ class Simulation final : public Kernel<kDim> {
   long checkpoint_every_steps_ = 0;
   double checkpoint_every_minutes_ = 0;
   bool checkpoint_at_end_ = true;
+  std::string boundary_report_;  ///< see boundary_report()
+  void check_boundary_reach();
   bool positions_changed_ = true;
   bool moving_ = false;
   std::size_t initial_particles_ = 0;  ///< as the scene made them
