@@ -404,7 +404,9 @@ class Runner:
         if status == "ok":
             self.report.checked.append(f"{where}: scene, frostmpm check {path}  [{secs:.1f} s]")
         else:
-            self.fail(where, f"scene fails `frostmpm check` ({status})", detail)
+            at = re.search(re.escape(os.path.basename(path)) + r":(\d+):\d+", detail)
+            line = block.line + int(at.group(1)) if at else block.line  # the scene's line in the doc
+            self.fail(f"{block.doc}:{line}", f"scene fails `frostmpm check` ({status})", detail)
 
     def python_block(self, block, root):
         where = f"{block.doc}:{block.line}"
@@ -429,6 +431,8 @@ class Runner:
 
     def check_doc(self, path):
         rel = os.path.relpath(path, self.repo)
+        if rel.startswith(".."):
+            rel = path
         root = self.scratch_root()
         try:
             for block in parse_blocks(path, rel):
