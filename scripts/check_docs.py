@@ -395,10 +395,7 @@ class Runner:
         if block.save:
             path = block.save
         else:
-            path = os.path.join(".docs-check", f"{os.path.basename(block.doc)}-{block.line}.yaml")
-            os.makedirs(os.path.join(root, ".docs-check"), exist_ok=True)
-            with open(os.path.join(root, path), "w", encoding="utf-8") as f:
-                f.write(block.text + "\n")
+            path = os.path.relpath(self.scratch_file(block, root, "yaml"), root)
         status, secs, detail = self.execute(f"frostmpm check {shlex.quote(path)}", root,
                                             capped_ok=bool(block.skip))
         if status == "ok":
@@ -407,6 +404,15 @@ class Runner:
             at = re.search(re.escape(os.path.basename(path)) + r":(\d+):\d+", detail)
             line = block.line + int(at.group(1)) if at else block.line  # the scene's line in the doc
             self.fail(f"{block.doc}:{line}", f"scene fails `frostmpm check` ({status})", detail)
+
+    @staticmethod
+    def scratch_file(block, root, extension):
+        """Writes the block's text to ROOT/.docs-check/<doc>-<line>.<extension>; returns the path."""
+        path = os.path.join(root, ".docs-check", f"{os.path.basename(block.doc)}-{block.line}.{extension}")
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(block.text + "\n")
+        return path
 
     def python_block(self, block, root):
         where = f"{block.doc}:{block.line}"
@@ -418,10 +424,7 @@ class Runner:
         if missing:
             self.report.skipped.append(f"{where}: python block  [{sys.executable} lacks {', '.join(missing)}]")
             return
-        path = os.path.join(root, ".docs-check", f"{os.path.basename(block.doc)}-{block.line}.py")
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(block.text + "\n")
+        path = self.scratch_file(block, root, "py")
         status, secs, detail = self.execute(f"{shlex.quote(sys.executable)} {shlex.quote(path)}", root,
                                             capped_ok=bool(block.skip))
         if status == "ok":

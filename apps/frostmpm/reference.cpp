@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "frostmpm/scene/plugin_setup.hpp"
+#include "frostmpm/simulation/simulation.hpp"
 
 namespace frostmpm::app {
 namespace {
@@ -82,9 +83,8 @@ int cmd_describe(const std::string& target, bool markdown, const std::vector<std
   // A kind nobody registered is a typo or a scene section, not a missing plugin: say which.
   if (const std::string kind = target.substr(0, slash); target != "all" && registry.entries(kind).empty()) {
     const auto kinds = registry.kinds();
-    static const std::vector<std::string> kernel_sections = {"grid",    "time",   "gravity", "regions",   "materials",
-                                                             "output", "probes", "checkpoint", "boundary_conditions"};
-    if (std::find(kernel_sections.begin(), kernel_sections.end(), kind) != kernel_sections.end())
+    const auto sections = Simulation::sections();  // `physics` is also a kind, found above
+    if (std::find(sections.begin(), sections.end(), kind) != sections.end())
       throw InputError("describe: '" + kind + "' is a scene section the kernel reads, not a plugin kind: "
                        "docs/config-reference.md lists its keys, and `frostmpm check SCENE` prints them with their "
                        "defaults. Plugin kinds: " + join(kinds));

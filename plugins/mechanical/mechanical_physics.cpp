@@ -339,21 +339,6 @@ void MechanicalPhysics<Dim>::initialize() {
     densities(p, rho_m, skeleton, n_l);
     inertia[p] = mass_scaling_ * (liquid_drag_.bound() ? skeleton : rho_m);
   }
-  // Conditions that act on no material are a silent no-op: refuse them.
-  std::vector<char> reached(kernel_->grid().node_count(), 0);
-  const auto& st = kernel_->transfer().stencil();
-  const auto vol = volume_.values();
-  for (std::size_t p = 0; p < n; ++p)
-    for (int k = 0; k < st.per_particle(); ++k)
-      if (st.weights(p)[k] > 0 && vol[p] > 0) reached[st.nodes(p)[k]] = 1;
-  auto check = [&](const BoundaryCondition* bc, const std::vector<std::size_t>& nodes) {
-    if (std::none_of(nodes.begin(), nodes.end(), [&](std::size_t i) { return reached[i] != 0; }))
-      throw bc->node->error("the " + bc->label() + " touches no node the material reaches: it would do nothing");
-  };
-  for (const auto& c : velocity_bcs_) check(c.bc, c.nodes);
-  for (const auto& c : plates_) check(c.bc, c.nodes);
-  for (const auto& c : traction_bcs_)
-    if (c.particles.empty()) check(c.bc, c.nodes);
 }
 
 /// σ′_v(p) = −|g| (Σ over the particles above p in its column of ρ_m Δz + ½ ρ_m Δz of p) + p_l,

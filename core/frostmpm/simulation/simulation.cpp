@@ -86,8 +86,9 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
 
 /// A condition on nodes acts through the material its nodes carry: on a face the material does
 /// not reach (a grid taller than the soil, as is usual in MPM) it would change nothing and the
-/// run would "finish" with no thaw. Refused when nothing moves; when the skeleton moves the
-/// material may arrive later, so it is a warning. `check` reports every condition's reach.
+/// run would "finish" with no thaw. Refused for every physics' conditions, moving or not: a
+/// condition does not follow the material surface, so one that starts off the material is a
+/// mistake in the scene. `check` reports every condition's reach.
 void Simulation::check_boundary_reach() {
   std::vector<std::uint8_t> reached(grid_.node_count(), 0);
   const auto& stencil = transfer_.stencil();
@@ -98,30 +99,27 @@ void Simulation::check_boundary_reach() {
     for (int k = 0; k < K; ++k)
       if (w[k] > 0) reached[nodes[k]] = 1;
   }
-  // The material's extent, for the message: the union of the particle domains.
-  const auto pos = particles_.field("position"), half = particles_.field("half_size");
-  std::array<double, kDim> lo, hi;
-  lo.fill(std::numeric_limits<double>::infinity());
-  hi.fill(-std::numeric_limits<double>::infinity());
-  for (std::size_t p = 0; p < particles_.size(); ++p)
-    for (int d = 0; d < kDim; ++d) {
-      lo[d] = std::min(lo[d], pos[p * kDim + d] - half[p * kDim + d]);
-      hi[d] = std::max(hi[d], pos[p * kDim + d] + half[p * kDim + d]);
-    }
   std::ostringstream report;
   for (const auto& bc : bcs_) {
     if (bc.on_particles) continue;
     const auto count = std::count_if(bc.nodes.begin(), bc.nodes.end(), [&](std::size_t n) { return reached[n] != 0; });
     report << bc.label() << ": " << count << " of " << bc.nodes.size() << " nodes carry material\n";
     if (count > 0) continue;
-    const std::string message = bc.label() + " acts on " + std::to_string(bc.nodes.size()) +
-                                " node(s), none of which the material reaches (it spans x in [" + number_text(lo[0], 6) +
-                                ", " + number_text(hi[0], 6) + "], y in [" + number_text(lo[1], 6) + ", " +
-                                number_text(hi[1], 6) + "] m), so it would change nothing";
-    if (!moving_)
-      throw bc.node->error(message + "; put it where the material is (a face the material touches, or nodes: {box: ...} "
-                                     "at its surface)");
-    log::warning(bc.node->where().describe() + ": " + message + " until material moves there");
+    // The material's extent, for the message: the union of the particle domains.
+    const auto pos = particles_.field("position"), half = particles_.field("half_size");
+    std::array<double, kDim> lo, hi;
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (std::size_t p = 0; p < particles_.size(); ++p)
+      for (int d = 0; d < kDim; ++d) {
+        lo[d] = std::min(lo[d], pos[p * kDim + d] - half[p * kDim + d]);
+        hi[d] = std::max(hi[d], pos[p * kDim + d] + half[p * kDim + d]);
+      }
+    throw bc.node->error(bc.label() + " acts on " + std::to_string(bc.nodes.size()) +
+                         " node(s), none of which the material reaches (it spans x in [" + number_text(lo[0], 6) +
+                         ", " + number_text(hi[0], 6) + "], y in [" + number_text(lo[1], 6) + ", " +
+                         number_text(hi[1], 6) + "] m), so it would change nothing; put it where the material is (a "
+                         "face the material touches, or nodes: {box: ...} at its surface)");
   }
   boundary_report_ = report.str();
 }
@@ -341,22 +339,27 @@ void Simulation::apply_initial_values() {
       };
       auto column = particles_.field(field);
       const int c = particles_.components(field);
-      // One value, a number or {expression: ...} of x and y, into components [k, k + n) of the
-      // region's particles.
+      // One value, a number, a profile table, a water table or an expression of x and y, into
+      // components [k, k + n) of the region's particles.
       auto assign = [&](const ConfigNode& value_node, int k, int n) {
+        // Every form's value at particle p goes through here: checked, then stored.
+        // `what` names the value when it is refused ("at (x, y) the expression's value ").
+        auto store = [&](std::size_t p, double value, const ConfigNode& node, const std::string& what) {
+          if (const auto why = problem(value); !why.empty())
+            throw node.error(what + number_text(value) + " " + why);
+          std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+        };
+        const auto at_particle = [&](std::size_t p) {
+          return "at (" + number_text(pos[p * kDim], 6) + ", " + number_text(pos[p * kDim + 1], 6) + ") ";
+        };
         if (!value_node.is_map()) {
           const double value = value_node.as_real();
-          if (const auto why = problem(value); !why.empty())
-            throw value_node.error("the value " + number_text(value) + " " + why);
-          for (std::size_t p = init.range.begin; p < init.range.end; ++p)
-            std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          for (std::size_t p = init.range.begin; p < init.range.end; ++p) store(p, value, value_node, "the value ");
           return;
         }
         if (value_node.has("table")) {
           assign_profile(value_node, init.range, pos, kDim, [&](std::size_t p, double value) {
-            if (const auto why = problem(value); !why.empty())
-              throw value_node.child("table").error("the value " + number_text(value) + " " + why);
-            std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+            store(p, value, value_node.child("table"), at_particle(p) + "the table's value ");
           });
           return;
         }
@@ -367,22 +370,18 @@ void Simulation::apply_initial_values() {
           const double level = h.child("water_table").as_real();
           h.finish({"water_table"});
           value_node.finish({"hydrostatic"});
-          const double g = std::hypot(gravity_[0], gravity_[1]);
-          if (g == 0)
+          double g2 = 0;
+          for (double g : gravity_) g2 += g * g;
+          if (g2 == 0)
             throw h.error("hydrostatic pressure needs gravity, and the scene's gravity is zero; give "
                           "{expression: \"rho*g*(h - y)\"} instead");
           const Material& material = materials_[init.range.material];
           if (!material.params.has("water_density"))
             throw h.error("hydrostatic pressure needs the material's water_density (a hydraulic material)");
           // p = ρ_l g (h − y): the convention of the hydrostatic pore_pressure boundary.
-          const double rho_g = material.params.real("water_density") * g;
-          for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
-            const double value = rho_g * (level - pos[p * kDim + kDim - 1]);
-            if (const auto why = problem(value); !why.empty())
-              throw h.error("at y = " + number_text(pos[p * kDim + kDim - 1], 6) + " the hydrostatic pressure " +
-                            number_text(value) + " " + why);
-            column[p * c + k] = value;
-          }
+          const double rho_g = material.params.real("water_density") * std::sqrt(g2);
+          for (std::size_t p = init.range.begin; p < init.range.end; ++p)
+            store(p, rho_g * (level - pos[p * kDim + kDim - 1]), h, at_particle(p) + "the hydrostatic pressure ");
           return;
         }
         const ConfigNode text = value_node.child("expression");
@@ -395,11 +394,7 @@ void Simulation::apply_initial_values() {
         }
         for (std::size_t p = init.range.begin; p < init.range.end; ++p) {
           const double at[2] = {pos[p * kDim], pos[p * kDim + 1]};
-          const double value = f.evaluate(at);
-          if (const auto why = problem(value); !why.empty())
-            throw value_node.error("at (" + number_text(at[0], 6) + ", " + number_text(at[1], 6) +
-                                   ") the expression's value " + number_text(value) + " " + why);
-          std::fill_n(column.begin() + std::ptrdiff_t(p * c + k), n, value);
+          store(p, f.evaluate(at), value_node, at_particle(p) + "the expression's value ");
         }
       };
       if (entry.is_sequence()) {
