@@ -21,55 +21,17 @@
 #include "frostmpm/models/model_contract.hpp"
 #include "frostmpm/plugin/plugin_loader.hpp"
 #include "frostmpm/scene/model_section.hpp"
+#include "mechanical_model_testing.hpp"
 #include "test_support.hpp"
 
 namespace {
 
 using frostmpm::MechanicalModel;
-using Voigt = std::array<double, 6>;  // xx, yy, zz, yz, xz, xy; tensor shear strains
+using frostmpm::test::Voigt;
 
-/// `material: {mechanical_model: {model: NAME, params}}` -> read_model_section -> create.
-std::shared_ptr<MechanicalModel> make_model(const frostmpm::Registry& registry, const std::string& name,
-                                            const std::string& params) {
-  const std::string text =
-      "material:\n  mechanical_model: {model: " + name + (params.empty() ? "" : ", " + params) + "}\n";
-  const auto root = frostmpm::ConfigNode::load_string(text, "mechanical-test.yaml");
-  const auto section =
-      frostmpm::read_model_section(registry, MechanicalModel::kKind, root.child("material").child("mechanical_model"));
-  return section.create<MechanicalModel>(registry);
-}
-
-std::shared_ptr<MechanicalModel> make_model(const std::string& name, const std::string& params) {
-  return make_model(frostmpm::test::builtin_registry(), name, params);
-}
-
-/// One point's update; S_c < 0 passes no ice saturation (a scene without thermal physics).
-struct Update {
-  Voigt stress{};
-  std::array<double, 36> tangent{};
-  double p_wave = 0, shear = 0;
-  bool failed = false;
-};
-
-Update integrate(const MechanicalModel& model, const Voigt& strain, const Voigt& start, double S_c) {
-  Update u;
-  const double ice[1] = {S_c};
-  std::uint8_t failed[1] = {0};
-  frostmpm::StressUpdateInput in;
-  in.strain_increment = strain;
-  in.stress_start = start;
-  if (S_c >= 0) in.ice_saturation = ice;
-  in.dt = 1e-3;
-  frostmpm::StressUpdateOutput out;
-  out.stress = u.stress;
-  out.failed = failed;
-  out.tangent = u.tangent;
-  out.p_wave_modulus = {&u.p_wave, 1};
-  out.shear_modulus = {&u.shear, 1};
-  model.integrate(in, out);
-  u.failed = failed[0] != 0;
-  return u;
-}
+using frostmpm::test::integrate;
+using frostmpm::test::make_model;
+using Update = frostmpm::test::StressUpdate;
 
 /// Lamé constants of (E, ν).
 struct Elastic {
@@ -87,7 +49,20 @@ const std::map<std::string, std::vector<std::string>>& mechanical_cases() {
         "youngs_modulus: 2.0e8, poisson_ratio: 0.49, frozen_youngs_modulus: 1.0e9",   // nearly incompressible
         "youngs_modulus: 1.0e5, poisson_ratio: -0.5",                                  // auxetic, soft
         "youngs_modulus: 1.0e10, poisson_ratio: 0.25, frozen_youngs_modulus: 1.0e3",    // ice softens
-        "youngs_modulus: 1.0e6, poisson_ratio: 0.0, frozen_youngs_modulus: 2.0e7, modulus_change: elastic_strain"}}};
+        "youngs_modulus: 1.0e6, poisson_ratio: 0.0, frozen_youngs_modulus: 2.0e7, modulus_change: elastic_strain"}},
+      {"mohr_coulomb",
+       {"youngs_modulus: 1.0e7, poisson_ratio: 0.3, cohesion: 1.0e4, friction_angle: 30, dilation_angle: 10",
+        "youngs_modulus: 1.0e7, poisson_ratio: 0.3, cohesion: 0, friction_angle: 35",           // cohesionless sand
+        "youngs_modulus: 1.0e8, poisson_ratio: 0.49, cohesion: 5.0e4, friction_angle: 0",       // Tresca, undrained
+        "youngs_modulus: 1.0e7, poisson_ratio: 0.25, cohesion: 2.0e4, residual_cohesion: 1.0e4, friction_angle: 30, "
+        "residual_friction_angle: 25, dilation_angle: 5, residual_dilation_angle: 0, softening_rate: 50",
+        "youngs_modulus: 1.0e7, poisson_ratio: 0.3, cohesion: 5.0e4, friction_angle: 30, tensile_strength: 1.0e4"}},
+      {"mohr_coulomb_ice",
+       {// the paper's strip footing (Sec. 5.3.2) and thaw slump (Sec. 5.3.1)
+        "youngs_modulus: 1.0e8, poisson_ratio: 0.3, cohesion: 2.0e4, residual_cohesion: 1.0e4, friction_angle: 30, "
+        "softening_rate: 5, max_ice_cohesion: 2.0e5, ice_bonding_rate: 0.05, lambda: 0.4",
+        "youngs_modulus: 2.0e7, poisson_ratio: 0.3, cohesion: 2.0e3, friction_angle: 20, max_ice_cohesion: 2.0e5, "
+        "max_ice_friction_angle: 15, max_ice_dilation_angle: 5, ice_bonding_rate: 0.05, lambda: 0.4"}}};
   return cases;
 }
 

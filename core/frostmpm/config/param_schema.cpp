@@ -94,7 +94,7 @@ std::string ParamSpec::range_text() const {
 }
 
 std::string ParamSpec::default_text() const {
-  if (!default_value) return "required";
+  if (!default_value) return optional_meaning.empty() ? "required" : "optional: " + optional_meaning;
   YAML::Emitter out;
   out << to_yaml(*default_value);
   return out.c_str();
@@ -258,6 +258,8 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
       set.set(spec.name, read_value(spec, value), value.where());
     } else if (spec.default_value) {
       set.set(spec.name, *spec.default_value, node.where());
+    } else if (!spec.required()) {
+      continue;  // optional: absent
     } else {
       std::string message = "missing required parameter '" + spec.name + "' (" + spec.doc;
       if (!spec.unit.empty()) message += ", " + spec.unit;

@@ -24,13 +24,16 @@ struct ParamSpec {
   ParamType type = ParamType::Real;
   std::string unit;  ///< "" for dimensionless or not numeric
   std::string doc;
-  std::optional<ParamValue> default_value;  ///< empty: required
+  std::optional<ParamValue> default_value;  ///< empty: required (unless optional_meaning is set)
+  /// Set by optional(): the parameter may be left out and then has no value at all (ParamSet::has
+  /// is false); the text says what the model does without it ("the peak value").
+  std::string optional_meaning;
   std::optional<double> lower, upper;
   bool lower_open = false, upper_open = false;
   std::vector<std::string> choices;  ///< for Choice
   std::size_t list_size = 0;         ///< for RealList; 0 = any length
 
-  bool required() const { return !default_value.has_value(); }
+  bool required() const { return !default_value.has_value() && optional_meaning.empty(); }
 
   // Fluent setters used by schema declarations.
   // Defaults are stored in the parameter's own type: `defaults_to(0)` on a real is 0.0, and a
@@ -47,12 +50,15 @@ struct ParamSpec {
   ParamSpec& at_most(double v) { upper = v; upper_open = false; return *this; }
   ParamSpec& below(double v) { upper = v; upper_open = true; return *this; }
   ParamSpec& size(std::size_t n) { list_size = n; return *this; }
+  /// Optional with no default value: left out, the model falls back on `meaning` itself (a
+  /// residual strength that is the peak one unless given).
+  ParamSpec& optional(std::string meaning) { optional_meaning = std::move(meaning); return *this; }
 
   /// Whether `v` lies within the declared bounds (always, when unbounded).
   bool in_range(double v) const;
   /// "(0, 1]" style text for docs and messages; "" when unbounded.
   std::string range_text() const;
-  /// Default as YAML text, or "required".
+  /// Default as YAML text, "optional: <meaning>", or "required".
   std::string default_text() const;
 };
 

@@ -57,6 +57,13 @@ class MechanicalModel {
   /// Their values before the first step.
   virtual std::vector<double> initial_state() const { return std::vector<double>(internal_variables().size(), 0.0); }
   virtual void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const = 0;
+  /// A plasticity model's yield function F(σ′, internal variables) for n points [Pa], ≤ 0 where
+  /// the stress is admissible: `frostmpm test-model` checks that every returned stress lies on or
+  /// inside the surface its internal variables describe. false: the model has no yield surface.
+  virtual bool yield_function(std::span<const double> /*stress*/, std::span<const double> /*state*/,
+                              std::span<double> /*value*/) const {
+    return false;
+  }
   /// The largest P-wave modulus K + 4G/3 the model can reach [Pa] (over every ice saturation):
   /// bounds the stable step before the first update.
   virtual double max_p_wave_modulus() const = 0;

@@ -230,11 +230,20 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint64_t kSeed = 20240611;
 constexpr double kMaxMeanStress = 1e6;       // Pa, compressive
 constexpr double kDeviatorFraction = 0.2;    // of the mean stress, for the loading step
+// Every other sample is loaded 15 times as far: beyond the friction of any soil, so that an
+// elastoplastic model starts those samples on its yield surface and its plastic branch (the
+// return and its tangent) is checked as often as its elastic one.
+constexpr double kYieldingLoad = 15.0;
 constexpr double kMaxStrainIncrement = 1e-3;
 constexpr double kTemperatureRange[2] = {-20.0, 20.0};
 constexpr double kMaxPorePressure = 1e6;     // Pa
 constexpr double kStep = 1e-3;               // s, a typical explicit step
-constexpr double kStrainStep = 1e-7;         // finite differences of the tangent (and half of it)
+// Finite differences of the tangent (and half of it): 1e-7, or less for a model stiffer than
+// 1e7 Pa, by the square root of the excess, between the curvature of a return map (its principal
+// directions turn with the strain), which wants small steps, and the round-off of a return from
+// a large trial stress, which wants large ones.
+constexpr double kStrainStep = 1e-7;
+constexpr double kReferenceModulus = 1e7;  // Pa
 
 /// Q A Qᵀ of a symmetric tensor in Voigt order.
 Voigt rotate(const Matrix3& Q, const double* a) {
@@ -322,7 +331,8 @@ StressPoint random_point(Random& random, std::size_t i, const std::vector<double
   const double mean = i == 0 ? 0.0 : random.uniform(0, kMaxMeanStress);
   if (mean > 0)  // the first start stress is +0, not -0
     for (int k = 0; k < 3; ++k) p.stress[k] = -mean;
-  loading = random_strain(random, random.uniform(0, 1) * kDeviatorFraction * mean * loading_scale);
+  const double load = (i % 2 == 1 ? kYieldingLoad : 1.0) * kDeviatorFraction * mean * loading_scale;
+  loading = random_strain(random, random.uniform(0, 1) * load);
   p.strain = random_strain(random, random.uniform(0.01, 1.0) * kMaxStrainIncrement);
   p.state = state0;
   p.T = random.uniform(kTemperatureRange[0], kTemperatureRange[1]);
@@ -392,6 +402,7 @@ class MechanicalCheck {
     const StressResults base = integrate(model_, points_, names_.size(), true, true);
     check_outputs(base, true);
     check_outputs(integrate(model_, points_, names_.size(), false, false), false);
+    check_yield_surface(base);
     check_zero_increment();
     check_tangent(base);
     check_rotation(base, false);
@@ -425,7 +436,7 @@ class MechanicalCheck {
   }
 
   /// Start states the model reaches itself — one loading step from a hydrostatic compression p,
-  /// of a strain worth up to 0.2 p at the largest P-wave modulus — so an elastoplastic model
+  /// of a strain worth up to 0.2 p (every other sample 3 p) at the largest P-wave modulus — so an elastoplastic model
   /// starts on or inside its yield surface. A point whose loading fails starts hydrostatic.
   void sample_start_states() {
     const double M = model_.max_p_wave_modulus();
@@ -488,6 +499,20 @@ class MechanicalCheck {
     }
   }
 
+  /// A plasticity model: every returned stress lies on or inside the surface its own returned
+  /// internal variables describe (F ≤ 1e-8 of the stress's size).
+  void check_yield_surface(const StressResults& r) {
+    std::vector<double> F(points_.size(), kNaN);
+    if (!model_.yield_function(r.stress, r.state, F)) return;
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const double size = std::max(max_abs(&r.stress[6 * i], 6), 1.0);
+      if (r.failed[i] || !std::isfinite(size)) continue;  // reported by check_outputs
+      if (!(F[i] <= 1e-8 * size))
+        v_.add("yield surface", "the returned stress " + voigt_text(&r.stress[6 * i]) +
+                                    " Pa lies outside the yield surface: F = " + num(F[i]) + " Pa" + at(points_[i]));
+    }
+  }
+
   void check_zero_increment() {
     std::vector<StressPoint> still = points_;
     for (auto& p : still) p.strain.fill(0.0);
@@ -513,16 +538,16 @@ class MechanicalCheck {
     // (error O(h⁴)), or at a kink second-order one-sided ones.
     constexpr double kOffsets[4] = {-1.0, -0.5, 0.5, 1.0};
     const std::size_t n = points_.size();
+    const double h = kStrainStep * std::sqrt(std::min(1.0, kReferenceModulus / model_.max_p_wave_modulus()));
     std::vector<StressPoint> shifted;
     shifted.reserve(24 * n);
     for (const auto& p : points_)
       for (int j = 0; j < 6; ++j)
         for (const double offset : kOffsets) {
           shifted.push_back(p);
-          shifted.back().strain[j] += offset * kStrainStep;
+          shifted.back().strain[j] += offset * h;
         }
     const StressResults r = integrate(model_, shifted, names_.size(), true, false);
-    const double h = kStrainStep;
     for (std::size_t i = 0; i < n; ++i) {
       const double* D = &base.tangent[36 * i];
       const double* s = &base.stress[6 * i];
@@ -539,8 +564,15 @@ class MechanicalCheck {
       }
       double stress_size = max_abs(s, 6);
       for (std::size_t k = 0; k < 24; ++k) stress_size = std::max(stress_size, max_abs(&r.stress[6 * (24 * i + k)], 6));
-      // The differences lose ≈ ε |σ| / h to cancellation: an entry of that size is zero.
-      const double floor = 1e-6 * max_abs(D, 36) + 10 * std::numeric_limits<double>::epsilon() * stress_size / h;
+      // A return map subtracts from its elastic trial stress, which may be far larger.
+      stress_size = std::max(stress_size, max_abs(points_[i].stress.data(), 6) +
+                                              model_.max_p_wave_modulus() * max_abs(points_[i].strain.data(), 6));
+      // The differences lose ≈ 100 ε |σ| / h to cancellation (a return through an eigen-
+      // decomposition loses a few digits): an entry of that size is zero, and so
+      // is one below 1e-9 of the stiffest modulus the model can reach (at a plastic apex the
+      // whole tangent is zero and the differences are round-off of stresses near zero).
+      const double floor = 1e-6 * max_abs(D, 36) + 1e-9 * model_.max_p_wave_modulus() +
+                           100 * std::numeric_limits<double>::epsilon() * stress_size / h;
       const auto close = [&](double a, double b) {
         return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)) + floor;
       };

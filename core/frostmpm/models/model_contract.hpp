@@ -39,7 +39,7 @@ struct MechanicalModelCase {
 /// fixed seed, the same for every parameter set): strain increments up to 1e-3 in norm,
 /// T in [-20, 20] degC, S_c in [0, 1] (both ends included), p_l in [0, 1e6] Pa, and start
 /// stress and state the model reaches itself in one loading step from initial_state() and a
-/// hydrostatic compression p up to 1 MPa (a strain worth up to 0.2 p at max_p_wave_modulus();
+/// hydrostatic compression p up to 1 MPa (a strain worth up to 0.2 p, every other sample 3 p, at max_p_wave_modulus();
 /// the first start stress zero), so an elastoplastic model starts on or inside its yield
 /// surface. Rules:
 ///  - initial_state() has internal_variables().size() entries, all finite;

@@ -62,6 +62,37 @@ void take_material_constants(ModelSection& model, const ConfigNode& model_node, 
   }
 }
 
+/// An optional parameter a model section leaves out is the same-named parameter (same unit) of
+/// another model of the material: the ice-strength s_c of mohr_coulomb_ice reads λ from the
+/// freezing curve (sfcc: {model: van_genuchten_cc, lambda: ...}) instead of a second copy.
+/// Given in both sections, the two must agree.
+void share_between_models(std::map<std::string, ModelSection>& models, const ConfigNode& material) {
+  for (auto& [key, model] : models)
+    for (const auto& spec : model.entry->schema.params()) {
+      if (spec.optional_meaning.empty() || spec.type != ParamType::Real) continue;
+      for (const auto& [other_key, other] : models) {
+        if (other_key == key) continue;
+        const ParamSpec* theirs = other.entry->schema.find(spec.name);
+        if (!theirs || theirs->type != ParamType::Real || theirs->unit != spec.unit || !other.params.has(spec.name))
+          continue;
+        const double value = other.params.real(spec.name);
+        if (!model.params.has(spec.name)) {
+          if (!spec.in_range(value))
+            throw InputError(other.params.where(spec.name),
+                             spec.name + " = " + number_text(value) + " is outside the range " + spec.range_text() +
+                                 " that " + model.entry->kind + " model '" + model.entry->name + "' accepts");
+          model.params.set(spec.name, value, other.params.where(spec.name));
+        } else if (model.params.real(spec.name) != value) {
+          throw material.child(key).child(spec.name).error(
+              model.entry->kind + " model '" + model.entry->name + "' sets " + spec.name + " = " +
+              number_text(model.params.real(spec.name)) + " but the material's " + other_key + " model has " +
+              spec.name + " = " + number_text(value) + " (" + other.params.where(spec.name).describe() +
+              "): one quantity, one value; leave it out here to use that one");
+        }
+      }
+    }
+}
+
 }  // namespace
 
 std::vector<std::string> Simulation::sections() {
@@ -213,9 +244,11 @@ void Simulation::read_materials(const ConfigNode& node) {
       }
       auto model = read_model_section(registry_, slot.kind, section.child(slot.key));
       take_material_constants(model, section.child(slot.key), material.params, merged);
-      out[slot.key] = model.resolved();
       material.models.emplace(slot.key, std::move(model));
     }
+    share_between_models(material.models, section);
+    for (const auto& slot : slots)
+      if (const auto it = material.models.find(slot.key); it != material.models.end()) out[slot.key] = it->second.resolved();
     resolved[name] = out;
     materials_.push_back(std::move(material));
   }
