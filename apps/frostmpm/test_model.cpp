@@ -56,6 +56,27 @@ Parameters read_parameters(const RegistryEntry& entry, const std::vector<std::st
       out.picked.push_back(spec.name);
     }
   out.values = parse_params(entry.schema, ConfigNode(given, "--set"));
+  // An optional parameter the model cannot do without when nothing else supplies it (the λ that
+  // mohr_coulomb_ice reads from a scene's freezing curve): when the model refuses the set, the
+  // first optional parameter with a two-sided range whose picked value makes it accept is picked.
+  try {
+    (void)entry.create(out.values);
+  } catch (const InputError&) {
+    for (const auto& spec : entry.schema.params()) {
+      if (spec.optional_meaning.empty() || !spec.lower || !spec.upper || given[spec.name].IsDefined()) continue;
+      YAML::Node fuller = YAML::Clone(given);
+      fuller[spec.name] = picked_value(spec, model);
+      try {
+        ParamSet values = parse_params(entry.schema, ConfigNode(fuller, "--set"));
+        (void)entry.create(values);
+        out.values = std::move(values);
+        out.picked.push_back(spec.name);
+        break;
+      } catch (const InputError&) {
+        continue;  // not this one
+      }
+    }
+  }
   return out;
 }
 
