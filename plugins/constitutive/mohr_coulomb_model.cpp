@@ -86,6 +86,7 @@ MohrCoulombModel::MohrCoulombModel(const ParamSet& p, bool ice) : ice_(ice) {
   dilation_ = read("dilation_angle", "residual_dilation_angle", kDegree);
   softening_rate_ = p.real("softening_rate");
   tension_ = p.has("tensile_strength") ? p.real("tensile_strength") : std::numeric_limits<double>::infinity();
+  unbonded_ = mohr_coulomb::Strength::make(cohesion_.peak, friction_.peak, dilation_.peak, tension_);
   if (dilation_.peak > friction_.peak)
     throw p.error("dilation_angle", "dilation_angle = " + number_text(p.real("dilation_angle")) +
                                         " is above friction_angle = " + number_text(p.real("friction_angle")) +
@@ -136,22 +137,23 @@ double MohrCoulombModel::normalised_suction(double liquid_saturation) const {
 }
 
 mohr_coulomb::Strength MohrCoulombModel::strength(double plastic, double ice_saturation) const {
+  const bool bonded = ice_ && ice_saturation > 0;
+  if (!softens() && !bonded) return unbonded_;  // the peak strength, its sines computed once
   const double softening = std::exp(-softening_rate_ * plastic);
-  const double bonding =
-      ice_ && ice_saturation >= 0 ? 1.0 - std::exp(-bonding_rate_ * normalised_suction(1.0 - ice_saturation)) : 0.0;
-  mohr_coulomb::Strength s;
-  s.cohesion = cohesion_.at(softening, bonding);
-  s.friction = friction_.at(softening, bonding);
-  s.dilation = dilation_.at(softening, bonding);
-  s.tension = tension_;
-  return s;
+  const double bonding = bonded ? 1.0 - std::exp(-bonding_rate_ * normalised_suction(1.0 - ice_saturation)) : 0.0;
+  return mohr_coulomb::Strength::make(cohesion_.at(softening, bonding), friction_.at(softening, bonding),
+                                      dilation_.at(softening, bonding), tension_);
+}
+
+bool MohrCoulombModel::softens() const {
+  return softening_rate_ > 0 && (cohesion_.residual < cohesion_.peak || friction_.residual < friction_.peak ||
+                                 dilation_.residual < dilation_.peak);
 }
 
 mohr_coulomb::ReturnResult MohrCoulombModel::update_point(const double* trial, double plastic_start,
                                                           double ice_saturation, double* stress, double* tangent,
                                                           mohr_coulomb::Strength& used, bool& converged) const {
-  const bool softens = softening_rate_ > 0 && (cohesion_.residual < cohesion_.peak ||
-                                               friction_.residual < friction_.peak || dilation_.residual < dilation_.peak);
+  const bool softening = softens();
   double plastic = plastic_start;
   mohr_coulomb::ReturnResult r;
   converged = false;
@@ -159,13 +161,13 @@ mohr_coulomb::ReturnResult MohrCoulombModel::update_point(const double* trial, d
     used = strength(plastic, ice_saturation);
     r = mohr_coulomb::return_stress(trial, used, elastic_, stress, tangent);
     const double end = plastic_start + r.plastic_deviatoric;
-    if (!softens || std::abs(end - plastic) <= kRelativeChange * end + kAbsoluteChange) {
+    if (!softening || std::abs(end - plastic) <= kRelativeChange * end + kAbsoluteChange) {
       converged = true;
       break;
     }
     plastic = end;
   }
-  if (converged && softens && tangent && r.kind != mohr_coulomb::ReturnKind::elastic)
+  if (converged && softening && tangent && r.kind != mohr_coulomb::ReturnKind::elastic)
     add_softening_tangent(trial, plastic, ice_saturation, stress, r, tangent);
   return r;
 }
@@ -245,11 +247,7 @@ bool MohrCoulombModel::yield_function(std::span<const double> stress, std::span<
                                       std::span<double> value) const {
   for (std::size_t p = 0; p < value.size(); ++p) {
     const double* v = state.data() + kCount * p;
-    mohr_coulomb::Strength s;
-    s.cohesion = v[kCohesion];
-    s.friction = v[kFriction] * kDegree;
-    s.dilation = v[kDilation] * kDegree;
-    s.tension = tension_;
+    const auto s = mohr_coulomb::Strength::make(v[kCohesion], v[kFriction] * kDegree, v[kDilation] * kDegree, tension_);
     value[p] = mohr_coulomb::yield_value_of_stress(stress.data() + 6 * p, s);
   }
   return true;

@@ -54,7 +54,10 @@ class MohrCoulombModel : public MechanicalModel {
   void add_softening_tangent(const double* trial, double plastic_end, double ice_saturation, const double* stress,
                              const mohr_coulomb::ReturnResult& result, double* tangent) const;
 
+  bool softens() const;
+
   mohr_coulomb::Elasticity elastic_;
+  mohr_coulomb::Strength unbonded_;  ///< the peak strength without ice
   Parameter cohesion_, friction_, dilation_;  // angles in radians
   double softening_rate_ = 0, tension_ = 0;
   bool ice_ = false;

@@ -28,7 +28,7 @@ struct Planes {
 };
 
 Planes planes_of(const Strength& s) {
-  const double sf = std::sin(s.friction), sp = std::sin(s.dilation), k = 2 * s.cohesion * std::cos(s.friction);
+  const double sf = s.sin_friction, sp = s.sin_dilation, k = 2 * s.cohesion * s.cos_friction;
   Planes P;
   P.plane[0] = {Vec3(1 + sf, 0, -(1 - sf)), Vec3(1 + sp, 0, -(1 - sp)), k, 2 * sp};
   P.plane[1] = {Vec3(0, 1 + sf, -(1 - sf)), Vec3(0, 1 + sp, -(1 - sp)), k, 2 * sp};
@@ -170,16 +170,18 @@ void elastic_tangent(const Elasticity& e, double* D) {
 
 }  // namespace
 
-double Strength::apex() const {
-  return friction > 0 ? cohesion * std::cos(friction) / std::sin(friction) : kInf;
+Strength Strength::make(double cohesion, double friction, double dilation, double tension) {
+  return {cohesion, friction, dilation, tension, std::sin(friction), std::cos(friction), std::sin(dilation)};
 }
+
+double Strength::apex() const { return friction > 0 ? cohesion * cos_friction / sin_friction : kInf; }
 
 double Strength::tension_cutoff() const { return std::min(tension, apex()); }
 
 double yield_value(std::array<double, 3> p, const Strength& s) {
   std::sort(p.begin(), p.end(), std::greater<>());
-  const double sf = std::sin(s.friction);
-  const double cone = p[0] * (1 + sf) - p[2] * (1 - sf) - 2 * s.cohesion * std::cos(s.friction);
+  const double sf = s.sin_friction;
+  const double cone = p[0] * (1 + sf) - p[2] * (1 - sf) - 2 * s.cohesion * s.cos_friction;
   const double T = s.tension_cutoff();
   return std::isfinite(T) ? std::max(cone, p[0] - T) : cone;
 }
@@ -193,6 +195,18 @@ double yield_value_of_stress(const double* stress, const Strength& s) {
 ReturnResult return_stress(const double* trial, const Strength& s, const Elasticity& e, double* stress,
                            double* tangent) {
   ReturnResult result;
+  // Most points are elastic: the closed-form eigenvalues (no vectors) settle those clearly inside
+  // the surface; a point near it gets the iterative decomposition, accurate to round-off, so a
+  // stress returned onto the surface reads as on it again.
+  Eigen::SelfAdjointEigenSolver<Mat3> quick;
+  quick.computeDirect(to_matrix(trial), Eigen::EigenvaluesOnly);
+  const Vec3 rough = quick.eigenvalues();
+  const double rough_scale = std::max({rough.cwiseAbs().maxCoeff(), s.cohesion, 1.0});
+  if (yield_value({rough(0), rough(1), rough(2)}, s) < -1e-6 * rough_scale) {
+    std::copy(trial, trial + 6, stress);
+    if (tangent) elastic_tangent(e, tangent);
+    return result;
+  }
   const Eigen::SelfAdjointEigenSolver<Mat3> eigen(to_matrix(trial));
   // Descending: σ1 (the least compressive) first.
   const Vec3 principal(eigen.eigenvalues()(2), eigen.eigenvalues()(1), eigen.eigenvalues()(0));

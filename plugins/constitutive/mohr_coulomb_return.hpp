@@ -25,12 +25,15 @@
 
 namespace frostmpm::mohr_coulomb {
 
-/// The strength at one material point.
+/// The strength at one material point (make() fills the sines and cosines once).
 struct Strength {
   double cohesion = 0;   ///< c [Pa]
   double friction = 0;   ///< φ [rad], 0 ≤ φ < π/2
   double dilation = 0;   ///< ψ [rad], 0 ≤ ψ ≤ φ
   double tension = std::numeric_limits<double>::infinity();  ///< cut-off σ_t [Pa]; above c cot φ it changes nothing
+  double sin_friction = 0, cos_friction = 1, sin_dilation = 0;
+
+  static Strength make(double cohesion, double friction, double dilation, double tension);
 
   /// c cot φ: where the cone meets the hydrostatic axis (+∞ for φ = 0, Tresca).
   double apex() const;
