@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include "frostmpm/models/mechanical_model.hpp"
+#include "frostmpm/models/tensor3.hpp"
 #include "frostmpm/plugin/plugin_api.hpp"
 
 namespace frostmpm {
@@ -64,24 +65,14 @@ class LinearElastic final : public MechanicalModel {
       const double* de = in.strain_increment.data() + 6 * p;
       const double* s0 = in.stress_start.data() + 6 * p;
       double* s = out.stress.data() + 6 * p;
-      const double volumetric = lambda * (de[0] + de[1] + de[2]);
-      for (int i = 0; i < 3; ++i) s[i] = s0[i] + volumetric + 2.0 * G * de[i];
-      for (int i = 3; i < 6; ++i) s[i] = s0[i] + 2.0 * G * de[i];
+      tensor3::add_isotropic_increment(lambda, G, de, s0, s);
       if (secant_) {
         // The modulus of the last step (0 before the first: no change yet).
         const double E_last = in.state_start[p] > 0 ? in.state_start[p] : E;
         for (int i = 0; i < 6; ++i) s[i] += (E / E_last - 1.0) * s0[i];
         out.state[p] = E;
       }
-      if (!out.tangent.empty()) {
-        double* D = out.tangent.data() + 36 * p;
-        std::fill(D, D + 36, 0.0);
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) D[6 * i + j] = lambda;
-          D[6 * i + i] += 2.0 * G;
-        }
-        for (int i = 3; i < 6; ++i) D[6 * i + i] = 2.0 * G;
-      }
+      if (!out.tangent.empty()) tensor3::isotropic_tangent(lambda, G, out.tangent.data() + 36 * p);
       if (!out.p_wave_modulus.empty()) out.p_wave_modulus[p] = lambda + 2.0 * G;
       if (!out.shear_modulus.empty()) out.shear_modulus[p] = G;
     }

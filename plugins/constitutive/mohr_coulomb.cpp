@@ -6,18 +6,12 @@
 
 namespace frostmpm {
 
-class MohrCoulomb final : public MohrCoulombModel {
- public:
+struct MohrCoulombNames {
   static constexpr const char* kName = "mohr_coulomb";
   static constexpr const char* kDoc =
       "Mohr–Coulomb elastoplasticity (c, φ, ψ, softening, tension cut-off), return in principal stresses";
-  static ParamSchema schema() {
-    ParamSchema s;
-    declare(s, false);
-    return s;
-  }
-  explicit MohrCoulomb(const ParamSet& p) : MohrCoulombModel(p, false) {}
 };
+using MohrCoulomb = MohrCoulombRegistered<MohrCoulombNames, false>;
 
 FROSTMPM_REGISTER(MechanicalModel, MohrCoulomb)
 

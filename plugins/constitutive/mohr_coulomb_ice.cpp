@@ -6,18 +6,12 @@
 
 namespace frostmpm {
 
-class MohrCoulombIce final : public MohrCoulombModel {
- public:
+struct MohrCoulombIceNames {
   static constexpr const char* kName = "mohr_coulomb_ice";
   static constexpr const char* kDoc =
       "Mohr–Coulomb whose cohesion, friction and dilation grow with ice saturation (paper Eqs. 30–37)";
-  static ParamSchema schema() {
-    ParamSchema s;
-    declare(s, true);
-    return s;
-  }
-  explicit MohrCoulombIce(const ParamSet& p) : MohrCoulombModel(p, true) {}
 };
+using MohrCoulombIce = MohrCoulombRegistered<MohrCoulombIceNames, true>;
 
 FROSTMPM_REGISTER(MechanicalModel, MohrCoulombIce)
 

@@ -1,5 +1,7 @@
 #include "mohr_coulomb_model.hpp"
 
+#include "frostmpm/models/tensor3.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -188,11 +190,10 @@ void MohrCoulombModel::add_softening_tangent(const double* trial, double plastic
   for (int k = 0; k < 6; ++k) dev[k] = (drop[k] - (k < 3 ? mean : 0.0)) / (2 * G);
   double slope[6];  // dh/dΔε_j at fixed strength
   for (int j = 0; j < 6; ++j) {
+    // C_e applied to column j of D_ep: its deviatoric part / 2G plus its mean / (3K) on the diagonal.
+    const double column_mean = (tangent[j] + tangent[6 + j] + tangent[12 + j]) / 3;
     double M[6];
     for (int k = 0; k < 6; ++k) {
-      // C_e applied to column j of D_ep: deviatoric part / 2G plus mean / (3K) on the diagonal.
-      double column_mean = 0;
-      for (int i = 0; i < 3; ++i) column_mean += tangent[6 * i + j] / 3;
       const double ce = (tangent[6 * k + j] - (k < 3 ? column_mean : 0.0)) / (2 * G) + (k < 3 ? column_mean / (3 * K) : 0.0);
       M[k] = (k == j ? 1.0 : 0.0) - ce;
     }
@@ -215,15 +216,12 @@ void MohrCoulombModel::add_softening_tangent(const double* trial, double plastic
 void MohrCoulombModel::integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const {
   const std::size_t n = in.stress_start.size() / 6;
   const bool ice_given = ice_ && !in.ice_saturation.empty();
-  const double G = elastic_.G, lambda = elastic_.K - 2 * G / 3;
+  const double G = elastic_.G, lambda = elastic_.lambda();
   for (std::size_t p = 0; p < n; ++p) {
-    const double* de = in.strain_increment.data() + 6 * p;
-    const double* s0 = in.stress_start.data() + 6 * p;
     const double* start = in.state_start.data() + kCount * p;
     double trial[6];
-    const double volumetric = lambda * (de[0] + de[1] + de[2]);
-    for (int i = 0; i < 3; ++i) trial[i] = s0[i] + volumetric + 2 * G * de[i];
-    for (int i = 3; i < 6; ++i) trial[i] = s0[i] + 2 * G * de[i];
+    tensor3::add_isotropic_increment(lambda, G, in.strain_increment.data() + 6 * p, in.stress_start.data() + 6 * p,
+                                     trial);
     mohr_coulomb::Strength used;
     bool converged = false;
     const auto r = update_point(trial, start[kPlasticDeviatoric], ice_given ? in.ice_saturation[p] : -1.0,

@@ -36,12 +36,12 @@ class MohrCoulombModel : public MechanicalModel {
                       std::span<double> value) const override;
   double max_p_wave_modulus() const override;
 
+ private:
   /// c, φ, ψ after plastic deviatoric strain `plastic` at ice saturation S_c (< 0: none given).
   mohr_coulomb::Strength strength(double plastic, double ice_saturation) const;
   /// s_c of Eq. 37 at liquid saturation S_l (0 when thawed, +∞ when no liquid is left).
   double normalised_suction(double liquid_saturation) const;
 
- private:
   /// A strength that softens from its peak to its residual value (Eq. 35) and grows with ice (Eq. 36).
   struct Parameter {
     double peak = 0, residual = 0, ice = 0;
@@ -62,6 +62,21 @@ class MohrCoulombModel : public MechanicalModel {
   double softening_rate_ = 0, tension_ = 0;
   bool ice_ = false;
   double bonding_rate_ = 0, lambda_ = 0;
+};
+
+/// A registered name of the model: `Names` gives kName and kDoc, `Ice` whether the ice terms
+/// (and their parameters) are on. mohr_coulomb.cpp and mohr_coulomb_ice.cpp register one each.
+template <class Names, bool Ice>
+class MohrCoulombRegistered final : public MohrCoulombModel {
+ public:
+  static constexpr const char* kName = Names::kName;
+  static constexpr const char* kDoc = Names::kDoc;
+  static ParamSchema schema() {
+    ParamSchema s;
+    declare(s, Ice);
+    return s;
+  }
+  explicit MohrCoulombRegistered(const ParamSet& p) : MohrCoulombModel(p, Ice) {}
 };
 
 }  // namespace frostmpm

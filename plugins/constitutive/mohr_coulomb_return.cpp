@@ -1,5 +1,7 @@
 #include "mohr_coulomb_return.hpp"
 
+#include "frostmpm/models/tensor3.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <bit>
@@ -41,10 +43,7 @@ Planes planes_of(const Strength& s) {
   return P;
 }
 
-Mat3 principal_elasticity(const Elasticity& e) {
-  const double lambda = e.K - 2.0 * e.G / 3.0;
-  return Mat3::Constant(lambda) + 2.0 * e.G * Mat3::Identity();
-}
+Mat3 principal_elasticity(const Elasticity& e) { return Mat3::Constant(e.lambda()) + 2.0 * e.G * Mat3::Identity(); }
 
 struct ActiveSet {
   std::array<int, 3> planes;
@@ -158,15 +157,7 @@ void to_voigt(const Mat3& m, double* v) {
   v[5] = 0.5 * (m(0, 1) + m(1, 0));
 }
 
-void elastic_tangent(const Elasticity& e, double* D) {
-  const double lambda = e.K - 2.0 * e.G / 3.0;
-  std::fill(D, D + 36, 0.0);
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) D[6 * i + j] = lambda;
-    D[6 * i + i] += 2.0 * e.G;
-  }
-  for (int i = 3; i < 6; ++i) D[6 * i + i] = 2.0 * e.G;
-}
+void elastic_tangent(const Elasticity& e, double* D) { tensor3::isotropic_tangent(e.lambda(), e.G, D); }
 
 }  // namespace
 
@@ -198,8 +189,9 @@ ReturnResult return_stress(const double* trial, const Strength& s, const Elastic
   // Most points are elastic: the closed-form eigenvalues (no vectors) settle those clearly inside
   // the surface; a point near it gets the iterative decomposition, accurate to round-off, so a
   // stress returned onto the surface reads as on it again.
+  const Mat3 S = to_matrix(trial);
   Eigen::SelfAdjointEigenSolver<Mat3> quick;
-  quick.computeDirect(to_matrix(trial), Eigen::EigenvaluesOnly);
+  quick.computeDirect(S, Eigen::EigenvaluesOnly);
   const Vec3 rough = quick.eigenvalues();
   const double rough_scale = std::max({rough.cwiseAbs().maxCoeff(), s.cohesion, 1.0});
   if (yield_value({rough(0), rough(1), rough(2)}, s) < -1e-6 * rough_scale) {
@@ -207,7 +199,7 @@ ReturnResult return_stress(const double* trial, const Strength& s, const Elastic
     if (tangent) elastic_tangent(e, tangent);
     return result;
   }
-  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(to_matrix(trial));
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(S);
   // Descending: σ1 (the least compressive) first.
   const Vec3 principal(eigen.eigenvalues()(2), eigen.eigenvalues()(1), eigen.eigenvalues()(0));
   Mat3 Q;
@@ -232,7 +224,7 @@ ReturnResult return_stress(const double* trial, const Strength& s, const Elastic
   const Vec3 drop = principal - sigma;
   Mat3 change = Mat3::Zero();
   for (int a = 0; a < 3; ++a) change += drop(a) * Q.col(a) * Q.col(a).transpose();
-  to_voigt(to_matrix(trial) - change, stress);
+  to_voigt(S - change, stress);
   if (result.kind == ReturnKind::apex)  // exactly hydrostatic, in every frame
     for (int k = 0; k < 6; ++k) stress[k] = k < 3 ? sigma(0) : 0.0;
   const Vec3 deviatoric = (plastic.array() - plastic.mean()).matrix();

@@ -44,6 +44,7 @@ struct Strength {
 /// Isotropic elasticity: bulk and shear modulus [Pa].
 struct Elasticity {
   double K = 0, G = 0;
+  double lambda() const { return K - 2.0 * G / 3.0; }
 };
 
 enum class ReturnKind : std::uint8_t { elastic, plane, edge, tension, cone_and_tension, apex, failed };

@@ -47,6 +47,22 @@ inline void jaumann_rotate(const Mat& W, double dt, double* s) {
   from_matrix(out, s);
 }
 
+/// Isotropic Hooke in rate form: out = start + λ tr(Δε) I + 2G Δε (tensor shear strains).
+inline void add_isotropic_increment(double lambda, double G, const double* strain_increment, const double* start,
+                                    double* out) {
+  const double volumetric = lambda * (strain_increment[0] + strain_increment[1] + strain_increment[2]);
+  for (int i = 0; i < 3; ++i) out[i] = start[i] + volumetric + 2.0 * G * strain_increment[i];
+  for (int i = 3; i < 6; ++i) out[i] = start[i] + 2.0 * G * strain_increment[i];
+}
+
+/// Its tangent, 6 × 6 row-major: λ on the normal block, plus 2G on the diagonal.
+inline void isotropic_tangent(double lambda, double G, double* D) {
+  for (int k = 0; k < 36; ++k) D[k] = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) D[6 * i + j] = lambda;
+  for (int i = 0; i < 6; ++i) D[6 * i + i] += 2.0 * G;
+}
+
 /// Mean stress p = tr σ / 3 and the von Mises equivalent q = √(3 J2).
 inline double mean(const double* s) { return trace(s) / 3.0; }
 inline double von_mises(const double* s) {
