@@ -1,6 +1,7 @@
 #include "mohr_coulomb_model.hpp"
 
 #include "frostmpm/models/tensor3.hpp"
+#include "frostmpm/plugin/plugin_api.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -250,5 +251,40 @@ bool MohrCoulombModel::yield_function(std::span<const double> stress, std::span<
   }
   return true;
 }
+
+// ---- the two registered names: one model, with and without the ice terms ----------------------
+
+namespace {
+
+template <class Names, bool Ice>
+class Registered final : public MohrCoulombModel {
+ public:
+  static constexpr const char* kName = Names::kName;
+  static constexpr const char* kDoc = Names::kDoc;
+  static ParamSchema schema() {
+    ParamSchema s;
+    declare(s, Ice);
+    return s;
+  }
+  explicit Registered(const ParamSet& p) : MohrCoulombModel(p, Ice) {}
+};
+
+struct PlainNames {
+  static constexpr const char* kName = "mohr_coulomb";
+  static constexpr const char* kDoc =
+      "Mohr–Coulomb elastoplasticity (c, φ, ψ, softening, tension cut-off), return in principal stresses";
+};
+struct IceNames {
+  static constexpr const char* kName = "mohr_coulomb_ice";
+  static constexpr const char* kDoc =
+      "Mohr–Coulomb whose cohesion, friction and dilation grow with ice saturation (paper Eqs. 30–37)";
+};
+using MohrCoulomb = Registered<PlainNames, false>;
+using MohrCoulombIce = Registered<IceNames, true>;
+
+}  // namespace
+
+FROSTMPM_REGISTER(MechanicalModel, MohrCoulomb)
+FROSTMPM_REGISTER(MechanicalModel, MohrCoulombIce)
 
 }  // namespace frostmpm

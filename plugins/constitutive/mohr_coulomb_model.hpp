@@ -1,6 +1,6 @@
 #pragma once
-// The elastoplastic Mohr–Coulomb skeleton of the paper (Sec. 3.3, Eqs. 30–37), shared by the
-// registered models `mohr_coulomb` (no ice terms) and `mohr_coulomb_ice`.
+// The elastoplastic Mohr–Coulomb skeleton of the paper (Sec. 3.3, Eqs. 30–37), registered twice
+// (end of mohr_coulomb_model.cpp): `mohr_coulomb` without the ice terms, `mohr_coulomb_ice` with them.
 //
 // Strength Ψ ∈ {c, φ, ψ} at a point (Eqs. 34–37):
 //   Ψ = Ψ′ + Ψ_s,  Ψ′ = Ψ′_res + (Ψ′_p − Ψ′_res) exp(−η_s ε_p^d)          (softening, Eq. 35)
@@ -62,21 +62,6 @@ class MohrCoulombModel : public MechanicalModel {
   double softening_rate_ = 0, tension_ = 0;
   bool ice_ = false;
   double bonding_rate_ = 0, lambda_ = 0;
-};
-
-/// A registered name of the model: `Names` gives kName and kDoc, `Ice` whether the ice terms
-/// (and their parameters) are on. mohr_coulomb.cpp and mohr_coulomb_ice.cpp register one each.
-template <class Names, bool Ice>
-class MohrCoulombRegistered final : public MohrCoulombModel {
- public:
-  static constexpr const char* kName = Names::kName;
-  static constexpr const char* kDoc = Names::kDoc;
-  static ParamSchema schema() {
-    ParamSchema s;
-    declare(s, Ice);
-    return s;
-  }
-  explicit MohrCoulombRegistered(const ParamSet& p) : MohrCoulombModel(p, Ice) {}
 };
 
 }  // namespace frostmpm
