@@ -3,11 +3,14 @@
 
     /usr/bin/python3 scripts/plot_verification.py terzaghi OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py mandel OUT [OUT ...] [--png FILE]
+    /usr/bin/python3 scripts/plot_verification.py prandtl OUT [OUT ...] [--png FILE]
 
 terzaghi: configs/verification/terzaghi_consolidation.yaml runs (any cell sizes): the degree of
 consolidation U = settlement / (q H / E_oed) and the base pore pressure against Terzaghi's series
 (c_v = 0.1 m²/s, T_v = t / 10 s). mandel: configs/verification/mandel.yaml runs: p(0, t)/p0 at the
 centre against Mandel's series for ν = 0.3 (T = t / 50 s), with the Mandel–Cryer overshoot.
+prandtl: configs/verification/prandtl_footing.yaml runs: the footing pressure over (2 + π) c
+against the settlement in cells, labelled with the cell size and `volumetric_strain`.
 Each OUT is a run folder; the legend shows its cell size from run.json.
 """
 import argparse
@@ -75,15 +78,32 @@ def mandel(folders, png):
     frostplot.save(fig, png)
 
 
+def prandtl(folders, png):
+    q_u = (2 + np.pi) * 1e4
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for folder in folders:
+        m = metrics(folder)
+        scene = frostplot.run_summary(folder).get("resolved_scene", {})
+        h = scene["grid"]["cell_size"][0]
+        remedy = scene.get("physics", {}).get("mechanical", {}).get("volumetric_strain", "particle")
+        ax.plot(m["settlement"] / h, m["pressure"] / q_u, "-", lw=1, label=f"{cell_label(folder)}, {remedy}")
+    ax.axhline(1.0, color="k", lw=0.8, label="(2 + π) c")
+    ax.axvspan(0.25, 0.625, color="0.9", label="plateau read")
+    ax.set(xlabel="settlement d / h (cells of travel)", ylabel="q / (2 + π) c", ylim=(0, 1.5),
+           title="Prandtl's rough strip footing on Tresca soil")
+    ax.legend(fontsize=8)
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["terzaghi", "mandel"])
+    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png)")
     args = parser.parse_args()
     png = args.png or f"{args.figure}.png"
-    {"terzaghi": terzaghi, "mandel": mandel}[args.figure](args.folders, png)
+    {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl}[args.figure](args.folders, png)
     print(f"wrote {png}")
 
 

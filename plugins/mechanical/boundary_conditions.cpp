@@ -8,6 +8,9 @@
 //        faces (area: their extent across the normal), following the material as it moves
 //   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
 //                                                   the total force F [N, per m in 2-D] (Mandel)
+//   {type: footing, nodes: {box: ...}, y: v(t), contact: rough|smooth}  a rigid footing driven
+//        at a prescribed velocity along one axis: the nodes inside its box, which moves with it,
+//        follow it (rough: the other components held at 0); footing_* probes report it
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
 // ∂Ω_v) and record the force they exert on the material (reaction probes). Where conditions
 // meet on a node component:
@@ -158,6 +161,8 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     }
     plates_.push_back(std::move(c));
   }
+  for (auto* bc : kernel.boundary_conditions("footing")) read_footing(*bc, kernel);
+  place_footings();
   auto add_traction = [&](BoundaryCondition* bc, std::array<TimeFunction, Dim> value) {
     TractionCondition c;
     c.bc = bc;
@@ -235,6 +240,131 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
   }
 }
 
+template <int Dim>
+void MechanicalPhysics<Dim>::read_footing(BoundaryCondition& bc, const Kernel<Dim>& kernel) {
+  bc.accept_keys(with<std::string>({"contact"}, axis_keys<Dim>()));
+  if (bc.on_particles || bc.face_axis >= 0)
+    throw bc.node->error("a footing is a rigid body: give its extent as nodes: {box: {min: [...], max: [...]}}; the "
+                         "grid nodes inside the box, as it moves, follow the footing");
+  const auto& grid = kernel.grid();
+  const double end = kernel.end_time(), h = grid.min_spacing();
+  FootingCondition f;
+  const ConfigNode box = bc.node->child("nodes").child("box");
+  const auto lo = box.child("min").as_reals(), hi = box.child("max").as_reals();
+  for (int d = 0; d < Dim; ++d) f.lo[d] = lo.at(std::size_t(d)), f.hi[d] = hi.at(std::size_t(d));
+
+  std::array<std::optional<TimeFunction>, Dim> value;
+  int given = 0;
+  for (int d = 0; d < Dim; ++d)
+    if (auto v = bc.node->optional_child(axis_name(d))) {
+      value[d] = TimeFunction::read(*v, kMaxVelocity, end);
+      f.axis = d;
+      ++given;
+    }
+  if (given != 1)
+    throw bc.node->error("a footing moves along one axis: give its velocity as exactly one of " +
+                         join(axis_keys<Dim>(), ":, ") + ": (m/s, a constant, table or expression; ramp it from 0)");
+  const ConfigNode speed_node = bc.node->child(axis_name(f.axis));
+  std::string contact = "rough";
+  if (auto c = bc.node->optional_child("contact")) {
+    contact = c->as_string();
+    if (contact != "rough" && contact != "smooth")
+      throw c->error("unknown contact '" + contact +
+                     "'; valid: rough (the footing holds the material's other velocity components at 0), smooth "
+                     "(frictionless: it only pushes along its axis)");
+  }
+  if (contact == "rough")
+    for (int d = 0; d < Dim; ++d)
+      if (d != f.axis) value[d] = TimeFunction::constant(0.0);
+
+  // Its travel over the run (trapezoid on a fine sampling): the fastest speed bounds the step,
+  // the farthest reach must stay in the grid.
+  const TimeFunction& v = *value[f.axis];
+  constexpr int kSamples = 8192;
+  const double dt = end / kSamples;
+  double u = 0, u_min = 0, u_max = 0, peak = v(0.0), before = v(0.0);
+  for (int k = 1; k <= kSamples; ++k) {
+    const double t = k * dt, now = v(t);
+    u += 0.5 * (before + now) * dt;
+    before = now;
+    if (std::abs(now) > std::abs(peak)) peak = now;
+    u_min = std::min(u_min, u);
+    u_max = std::max(u_max, u);
+  }
+  if (peak == 0) throw speed_node.error("the footing's velocity is 0 over the whole run: it would never move");
+  f.direction = peak > 0 ? 1.0 : -1.0;
+  footing_limit_ = std::min(footing_limit_, h / std::abs(peak));
+  if (const double fixed = kernel.fixed_dt(); fixed > 0 && fixed * std::abs(peak) > h)
+    throw speed_node.error("at its fastest (" + number_text(std::abs(peak)) + " m/s) the footing would move " +
+                           number_text(fixed * std::abs(peak)) + " m in one step of time.dt = " + number_text(fixed) +
+                           " s, more than a grid cell (" + number_text(h) + " m): lower the speed or time.dt");
+  // The leading face (along the motion) must stay in the grid.
+  const double lead = f.direction < 0 ? f.lo[f.axis] + u_min : f.hi[f.axis] + u_max;
+  if (lead < grid.origin[f.axis] - 1e-9 * h || lead > grid.upper()[f.axis] + 1e-9 * h)
+    throw speed_node.error("the footing would leave the grid: its " + std::string(f.direction < 0 ? "lower" : "upper") +
+                           " face reaches " + axis_name(f.axis) + " = " + number_text(lead) + " m within the run, "
+                           "outside the grid's [" + number_text(grid.origin[f.axis]) + ", " +
+                           number_text(grid.upper()[f.axis]) + "] m; shorten the run or slow the footing");
+  f.contact_area = 1;
+  for (int d = 0; d < Dim; ++d)
+    if (d != f.axis)
+      f.contact_area *= std::max(0.0, std::min(f.hi[d], grid.upper()[d]) - std::max(f.lo[d], grid.origin[d]));
+
+  // Every node it will cover: no other condition may prescribe something else there.
+  auto swept_lo = f.lo, swept_hi = f.hi;
+  swept_lo[f.axis] += u_min;
+  swept_hi[f.axis] += u_max;
+  for (std::size_t i : box_nodes<Dim>(grid, swept_lo, swept_hi))
+    for (int d = 0; d < Dim; ++d) {
+      const int owner = value[d] ? constraint_owner_[i * Dim + d] : kFree;
+      if (owner == kFree) continue;
+      if (owner < kFree)
+        throw bc.node->error("the " + bc.label() + " would reach nodes whose " + axis_name(d) + " motion the " +
+                             plates_[std::size_t(-2 - owner)].bc->label() + " drives; keep the footing off the plate");
+      const VelocityCondition& other = velocity_bcs_[std::size_t(owner)];
+      if (!other.value[d]->same_values(*value[d]))
+        throw bc.node->error("the " + bc.label() + " would reach nodes where the " + other.bc->label() +
+                             " prescribes " + axis_name(d) + " = " + velocity_text(*other.value[d]) +
+                             ": a node component follows one value; shorten the footing's travel or move it");
+    }
+  f.velocity = velocity_bcs_.size();
+  VelocityCondition c;
+  c.bc = &bc;
+  c.value = std::move(value);
+  velocity_bcs_.push_back(std::move(c));
+  footings_.push_back(f);
+}
+
+template <int Dim>
+void MechanicalPhysics<Dim>::place_footings() {
+  for (auto& f : footings_) {
+    auto& c = velocity_bcs_[f.velocity];
+    const int index = static_cast<int>(f.velocity);
+    // Components another condition holds stay with it (read_footing checked they agree).
+    for (std::size_t i : c.nodes)
+      for (int d = 0; d < Dim; ++d)
+        if (constraint_owner_[i * Dim + d] == index) constraint_owner_[i * Dim + d] = kFree;
+    auto lo = f.lo, hi = f.hi;
+    lo[f.axis] += f.displacement;
+    hi[f.axis] += f.displacement;
+    c.nodes = box_nodes<Dim>(kernel_->grid(), lo, hi);
+    for (std::size_t i : c.nodes)
+      for (int d = 0; d < Dim; ++d)
+        if (c.value[d] && constraint_owner_[i * Dim + d] == kFree) constraint_owner_[i * Dim + d] = index;
+  }
+}
+
+template <int Dim>
+std::optional<Physics::RigidBodyMotion> MechanicalPhysics<Dim>::rigid_body(const BoundaryCondition& bc) const {
+  for (const auto& f : footings_) {
+    const auto& c = velocity_bcs_[f.velocity];
+    if (c.bc != &bc) continue;
+    // The reaction is the force on the material; along the motion it is the resistance.
+    return RigidBodyMotion{f.displacement * f.direction, c.reaction[std::size_t(f.axis)] * f.direction, f.contact_area};
+  }
+  return std::nullopt;
+}
+
 /// The axis of a particle condition's outward `normal:` ([0, -1]: the loaded faces face −y).
 template <int Dim>
 int MechanicalPhysics<Dim>::particle_normal_axis(const BoundaryCondition& bc) {
@@ -306,7 +436,10 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
   template int MechanicalPhysics<D>::particle_normal_axis(const BoundaryCondition&);               \
   template void MechanicalPhysics<D>::constrain(std::vector<double>&, double, double);             \
   template void MechanicalPhysics<D>::tie_plates(std::vector<double>&, double, double, bool);      \
-  template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const;
+  template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const; \
+  template void MechanicalPhysics<D>::read_footing(BoundaryCondition&, const Kernel<D>&);                 \
+  template void MechanicalPhysics<D>::place_footings();                                                     \
+  template std::optional<Physics::RigidBodyMotion> MechanicalPhysics<D>::rigid_body(const BoundaryCondition&) const;
 FROSTMPM_MECHANICAL_BOUNDARIES(2)
 FROSTMPM_MECHANICAL_BOUNDARIES(3)
 #undef FROSTMPM_MECHANICAL_BOUNDARIES

@@ -122,6 +122,12 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
            "symplectic: x += Δt v^k (the velocity the stress update used; second order); trapezoidal: "
            "x += Δt (v^k + ½ Δv), the paper's Algorithm 1 step 21 (first order with its stress update)")
       .defaults_to("symplectic");
+  s.choice("volumetric_strain", {"particle", "cell_average"},
+           "the volumetric strain increment the constitutive model sees: each particle's own, or the "
+           "volume-weighted mean over the particles in its grid cell (cell_average: a remedy for the volumetric "
+           "locking of nearly incompressible or isochoric plastic flow, Mast et al. 2012; the deviatoric part "
+           "and the particle's volume stay its own)")
+      .defaults_to("particle");
   s.choice("objective_rate", {"jaumann", "none"},
            "stress rate: Jaumann (objective, large rotations) or none (small-strain comparison)")
       .defaults_to("jaumann");
@@ -140,6 +146,7 @@ MechanicalPhysics<Dim>::MechanicalPhysics(const ParamSet& p) : params_(p) {
   jaumann_ = p.string("objective_rate") == "jaumann";
   trapezoidal_ = p.string("position_update") == "trapezoidal";
   geostatic_ = p.string("initial_stress") == "geostatic";
+  cell_average_ = p.string("volumetric_strain") == "cell_average";
   position_ = FieldHandle::particle("position", Dim, FieldKind::Vector);
   half_size_ = FieldHandle::particle("half_size", Dim, FieldKind::Vector);
   volume_ = FieldHandle::particle("volume");
@@ -233,6 +240,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
 
   const std::size_t n = kernel.particle_count(), nodes = kernel.grid().node_count();
   strain_increment_.assign(6 * n, 0.0);
+  if (cell_average_) thermal_strain_.assign(n, 0.0);
   rotated_.assign(6 * n, 0.0);
   wave_modulus_.assign(n, 0.0);
   previous_T_.assign(n, 0.0);
@@ -383,11 +391,13 @@ template <int Dim>
 void MechanicalPhysics<Dim>::begin_step(double time, double dt) {
   time_ = time;
   dt_ = dt;
+  place_footings();
 }
 
 template <int Dim>
 double MechanicalPhysics<Dim>::stable_time_step() const {
-  if (step_limit_valid_) return cfl_ * step_limit_;
+  // A footing crosses less than a cell per step, as the material does.
+  if (step_limit_valid_) return cfl_ * std::min(step_limit_, footing_limit_);
   // The same limit as map_to_particles takes.
   const double h = kernel_->grid().min_spacing();
   const auto v = velocity_.values();
@@ -403,7 +413,7 @@ double MechanicalPhysics<Dim>::stable_time_step() const {
         return speed > 0 ? h / speed : std::numeric_limits<double>::infinity();
       },
       std::numeric_limits<double>::infinity());
-  return cfl_ * limit;
+  return cfl_ * std::min(limit, footing_limit_);
 }
 
 // ---- the step --------------------------------------------------------------------------------------
@@ -523,6 +533,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     }
     for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
     for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
+    if (cell_average_) thermal_strain_[p] = thermal_strain;
     if (thermal) previous_T_[p] = T[p];
     double rho_m, skeleton, n_l;
     density(p, rho_m, skeleton, n_l);
@@ -535,6 +546,7 @@ void MechanicalPhysics<Dim>::update_stress() {
         << " s, step " << kernel_->step() << " (dt = " << dt_ << " s); the step may be too large or the loads too high";
     throw NumericalBlowUp(msg.str());
   }
+  if (cell_average_) average_volumetric_strain();
 
   // The constitutive models: one batch per material range, cut into fixed chunks that the
   // threads share (every point is integrated on its own, so the chunks change no result).
@@ -606,6 +618,44 @@ void MechanicalPhysics<Dim>::update_stress() {
   if (const auto first = std::find_if(failed_.begin(), failed_.end(), [](std::uint8_t f) { return f != 0; });
       first != failed_.end())
     report_failure(std::size_t(first - failed_.begin()));
+}
+
+/// The volumetric part of every particle's strain increment replaced by the volume-weighted mean
+/// of the kinematic volumetric increments in its grid cell (its own thermal strain still taken
+/// off): linear and GIMP shape functions give each cell too few independent volume changes for
+/// isochoric flow, and the mean over the cell relaxes that constraint as a B-bar element does.
+template <int Dim>
+void MechanicalPhysics<Dim>::average_volumetric_strain() {
+  const auto& grid = kernel_->grid();
+  const auto x = position_.values();
+  const auto vol = volume_.values();
+  const std::size_t n = kernel_->particle_count();
+  std::size_t cells = 1;
+  for (int d = 0; d < Dim; ++d) cells *= std::size_t(grid.cells[d]);
+  cell_of_.resize(n);
+  parallel_for(n, [&](std::size_t p) {
+    std::size_t index = 0;
+    for (int d = Dim - 1; d >= 0; --d) {
+      const int c = std::clamp(int(std::floor((x[p * Dim + d] - grid.origin[d]) / grid.spacing[d])), 0, grid.cells[d] - 1);
+      index = index * std::size_t(grid.cells[d]) + std::size_t(c);
+    }
+    cell_of_[p] = index;
+  });
+  // Sums in particle order, one thread: the same whatever the thread count.
+  cell_volume_.assign(cells, 0.0);
+  cell_strain_.assign(cells, 0.0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const double* de = strain_increment_.data() + 6 * p;
+    cell_volume_[cell_of_[p]] += vol[p];
+    cell_strain_[cell_of_[p]] += vol[p] * (de[0] + de[1] + de[2] + 3.0 * thermal_strain_[p]);
+  }
+  parallel_for(n, [&](std::size_t p) {
+    double* de = strain_increment_.data() + 6 * p;
+    const std::size_t c = cell_of_[p];
+    const double mean = cell_strain_[c] / cell_volume_[c] - 3.0 * thermal_strain_[p];
+    const double shift = (mean - (de[0] + de[1] + de[2])) / 3.0;
+    for (int i = 0; i < 3; ++i) de[i] += shift;
+  });
 }
 
 template <int Dim>
@@ -731,10 +781,13 @@ void MechanicalPhysics<Dim>::predict() {
   for (auto& c : velocity_bcs_) c.reaction = {};
   tie_plates(v_star, time_, dt_, true);
   // Cundall's local damping: a force against the motion, a fraction α of the unbalanced force —
-  // the net force of the step (internal, body, traction, plate load and drag), m Δv*/Δt.
+  // the net force of the step (internal, body, traction, plate load and drag), m Δv*/Δt. Only on
+  // free components: a held one takes its prescribed value, and its reaction must be the real
+  // unbalanced force (damped, a footing read 1 + α times the stress under it); a plate moves as one.
   if (damping_ > 0)
     parallel_for(mass_.size(), [&](std::size_t i) {
       for (int d = 0; d < Dim; ++d) {
+        if (constraint_owner_[i * Dim + d] != -1) continue;
         const double v = vn[i * Dim + d], change = v_star[i * Dim + d] - v;
         if (v != 0) v_star[i * Dim + d] = v + change - damping_ * std::abs(change) * (v > 0 ? 1.0 : -1.0);
       }
@@ -891,6 +944,11 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   });
   step_limit_ = limit;
   step_limit_valid_ = true;
+  // Each footing moves as its nodes moved the material under it this step.
+  for (auto& f : footings_) {
+    const TimeFunction& speed = *velocity_bcs_[f.velocity].value[f.axis];
+    f.displacement += dt_ * (trapezoidal_ ? 0.5 * (speed(time_) + speed(time_ + dt_)) : speed(time_));
+  }
   // The kinetic energy with the inertia the step used (mass scaling included: that is what must
   // stay small against the work for a scaled run to be quasi-static).
   kinetic_energy_ = kinetic;
@@ -938,6 +996,7 @@ void MechanicalPhysics<Dim>::map_to_particles() {
 template <int Dim>
 std::vector<PersistentArray> MechanicalPhysics<Dim>::persistent_state() {
   saved_scalars_ = {primed_ ? 1.0 : 0.0, kinetic_energy_, external_work_, kinetic_to_work_max_, elastic_energy_, removed_mass_};
+  for (const auto& f : footings_) saved_scalars_.push_back(f.displacement);
   return {{"scalars", &saved_scalars_},
           {"temperature_of_last_update", &previous_T_},
           {"wave_modulus", &wave_modulus_},
@@ -948,7 +1007,11 @@ template <int Dim>
 void MechanicalPhysics<Dim>::restored() {
   step_limit_valid_ = false;
   const auto& s = saved_scalars_;
-  if (s.size() != 6) throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 6");
+  const std::size_t expected = 6 + footings_.size();
+  if (s.size() != expected)
+    throw std::runtime_error("mechanical: checkpoint holds " + std::to_string(s.size()) + " scalars, expected " +
+                             std::to_string(expected));
+  for (std::size_t k = 0; k < footings_.size(); ++k) footings_[k].displacement = s[6 + k];
   removed_mass_ = s[5];
   elastic_energy_ = s[4];
   primed_ = s[0] != 0;
@@ -982,7 +1045,8 @@ void MechanicalPhysics<Dim>::removing_particles(const ParticleRemoval& removal) 
       removed_mass_ += rho_m * vol[p];  // [kg per m of thickness in 2-D]
     }
   }
-  for (auto* v : {&strain_increment_, &rotated_, &wave_modulus_, &previous_T_, &particle_mass_}) removal.compact(*v);
+  for (auto* v : {&strain_increment_, &rotated_, &wave_modulus_, &previous_T_, &particle_mass_, &thermal_strain_})
+    removal.compact(*v);
   removal.compact(failed_);
   for (auto& c : traction_bcs_) removal.remap(c.particles);
   step_limit_valid_ = false;

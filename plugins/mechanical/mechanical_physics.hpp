@@ -21,6 +21,7 @@
 // gradient and recomputes the stencils every step, since this physics writes `position`.
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -43,7 +44,7 @@ class MechanicalPhysics final : public Physics {
     return {{"mechanical_model", MechanicalModel::kKind, true}};
   }
   std::vector<std::string> boundary_types() const override {
-    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate"};
+    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate", "footing"};
   }
 
   void setup(Kernel<Dim>& kernel) override;
@@ -54,6 +55,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<PersistentArray> persistent_state() override;
   void restored() override;
   std::optional<std::array<double, 3>> reaction(const BoundaryCondition& bc) const override;
+  std::optional<RigidBodyMotion> rigid_body(const BoundaryCondition& bc) const override;
   std::vector<std::pair<std::string, double>> statistics() const override;
   void removing_particles(const ParticleRemoval& removal) override;
 
@@ -85,6 +87,17 @@ class MechanicalPhysics final : public Physics {
     TimeFunction load;                 ///< total force pushing into the material [N (per m in 2-D)]
     std::array<double, 3> applied{};   ///< the load over the last step, as a force on the material
   };
+  /// A rigid footing driven along one axis: the nodes inside its box, which moves with it, follow
+  /// its velocity (rough: the other components held at 0; smooth: left free). The prescribing
+  /// is a velocity condition (velocity_bcs_[velocity]) whose nodes are re-placed every step.
+  struct FootingCondition {
+    std::size_t velocity = 0;            ///< its condition in velocity_bcs_: values, nodes, reaction
+    std::array<double, Dim> lo{}, hi{};  ///< its box at t = 0 [m]
+    int axis = 0;
+    double direction = 1;     ///< the sign of its motion along `axis`
+    double contact_area = 0;  ///< the box across the axis, within the grid [m² (m in 2-D)]
+    double displacement = 0;  ///< along `axis` since t = 0, signed [m]
+  };
   struct MaterialData {
     std::shared_ptr<MechanicalModel> model;
     std::string model_name;
@@ -100,10 +113,13 @@ class MechanicalPhysics final : public Physics {
   static constexpr double kGrazingMass = 1e-6;
   double grazing_mass_ = 0;
   bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
+  bool cell_average_ = false;  ///< volumetric_strain: cell_average (average_volumetric_strain())
   std::vector<MaterialData> materials_;
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;
   std::vector<PlateCondition> plates_;
+  std::vector<FootingCondition> footings_;
+  double footing_limit_ = std::numeric_limits<double>::infinity();  ///< h / the fastest footing speed of the run [s]
   std::vector<int> constraint_owner_;  ///< node·Dim + d → velocity condition k ≥ 0, −1 free, −2 − k rigid plate k
 
   // ---- fields (bound by the kernel once the step is resolved)
@@ -117,6 +133,10 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> strain_increment_, rotated_, state_in_, state_out_, wave_modulus_, previous_T_;
   std::vector<double> particle_mass_;  ///< without pore-water flow: each particle's constant mass
   std::vector<std::uint8_t> failed_;
+  // ---- cell-averaged volumetric strain (only with cell_average_)
+  std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step
+  std::vector<std::size_t> cell_of_;              ///< per particle: its grid cell
+  std::vector<double> cell_volume_, cell_strain_; ///< per cell: Σ V, Σ V tr Δε_kinematic
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
   std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP
@@ -141,6 +161,10 @@ class MechanicalPhysics final : public Physics {
   /// Gives every plate's nodes one normal velocity, momentum-weighted with the nodal inertia
   /// m (+ Δt D when `with_drag`), plus `dt` times the plate's load at time t.
   void tie_plates(std::vector<double>& v, double t, double dt, bool with_drag);
+  /// Reads a footing condition (after the velocity conditions and plates, whose nodes it checks).
+  void read_footing(BoundaryCondition& bc, const Kernel<Dim>& kernel);
+  /// Gives each footing the nodes inside its box where it now is (each step, before the stages).
+  void place_footings();
   /// ρ_m, the skeleton's inertia per volume and n_l of particle p (S_l from the thermal physics, else 1).
   void densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
   /// densities() with what it reads fetched once, for loops over particles (a handle's values()
@@ -158,6 +182,7 @@ class MechanicalPhysics final : public Physics {
   void correct();
   void map_to_particles();
   void set_geostatic_stress();
+  void average_volumetric_strain();
   [[noreturn]] void report_failure(std::size_t p) const;
 };
 

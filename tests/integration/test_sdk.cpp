@@ -1,7 +1,7 @@
 // The third-party path end to end: install the SDK into a prefix, build an out-of-tree
-// template (examples/plugin-template, examples/constitutive-template) against it alone, put
-// it on FROSTMPM_PLUGIN_PATH and run a scene that names it — with the already-built frostmpm,
-// nothing of FrostMPM rebuilt.
+// example (examples/plugin-template, examples/constitutive-template, examples/drucker-prager)
+// against it alone, put it on FROSTMPM_PLUGIN_PATH and run a scene that names it — with the
+// already-built frostmpm, nothing of FrostMPM rebuilt.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -103,4 +103,55 @@ TEST_CASE("an out-of-tree constitutive model builds against the installed SDK, k
   CHECK(last[metrics.column("base_reaction")] == Approx((0.5 * 1990 + 0.5 * 1959.6) * 9.81 * 0.05).epsilon(1e-3));
   // The model's internal variable is a particle field of the run.
   CHECK(read_file(dir.file("out/run.json")).find("\"accumulated_shear_strain\"") != std::string::npos);
+}
+
+TEST_CASE("an out-of-tree plasticity model (Drucker-Prager) keeps its contract and reaches the closed-form strength",
+          "[sdk]") {
+  TempDir dir;
+  const std::string plugin_build = build_template(dir, "drucker-prager");
+  REQUIRE(fs::exists(plugin_build + "/libmy_drucker_prager.so"));
+
+  // The contract, as the example's README runs it: the picked parameters (and each at 1 % and
+  // 99 % of its range), then the scene's soil; both return to the cone and to its apex.
+  auto r = run_frostmpm("test-model mechanical_model/drucker_prager --plugin-path " + plugin_build);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(r.output.find("mechanical_model/drucker_prager: contract kept") != std::string::npos);
+  r = run_frostmpm("test-model mechanical_model/drucker_prager --plugin-path " + plugin_build +
+                   " --set youngs_modulus=4e7 --set cohesion=1e4 --set friction_angle=30 --set dilation_angle=30");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(r.output.find("mechanical_model/drucker_prager: contract kept") != std::string::npos);
+
+  const std::string env = "FROSTMPM_PLUGIN_PATH=" + plugin_build + " ";
+  r = run_command(env + frostmpm_exe() + " run " + dir.file("template/scene.yaml") + " -o " + dir.file("out"));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  // Plane-strain unconfined compression with associated flow: the plane-strain-matched cone is
+  // Mohr-Coulomb's, so the axial stress levels off at 2c cos(phi)/(1 - sin(phi)) (c = 10 kPa,
+  // phi = 30 degrees). sigma_v = -platen reaction / current width; the width follows the outermost
+  // particle columns, 0.95 m apart at the start.
+  const double phi = 30 * M_PI / 180, strength = 2 * 1.0e4 * std::cos(phi) / (1 - std::sin(phi));
+  REQUIRE(strength == Approx(34641.016).epsilon(1e-6));
+  const CsvTable metrics = read_csv(dir.file("out/metrics.csv"));
+  const std::size_t time_s = metrics.column("time_s"), platen = metrics.column("platen_reaction"),
+                    base = metrics.column("base_reaction"), left = metrics.column("u_left"),
+                    right = metrics.column("u_right");
+  CHECK(metrics.rows.back()[time_s] == Approx(12.0));
+  int plateau = 0;
+  for (const auto& row : metrics.rows) {
+    // Before 2 s the block is elastic, well below its strength: the plateau is reached by plastic flow.
+    if (row[time_s] <= 2.0) CHECK(-row[platen] < 0.6 * strength);
+    if (row[time_s] < 9.0 - 1e-6) continue;  // the plateau: from 0.2 % vertical strain on
+    INFO("t = " << row[time_s] << " s");
+    const double width = 1.0 + (row[right] - row[left]) / 0.95;
+    CHECK(-row[platen] / width == Approx(strength).epsilon(0.02));
+    CHECK(row[base] == Approx(-row[platen]).epsilon(0.01));  // quasi-static: the base balances the platen
+    ++plateau;
+  }
+  CHECK(plateau >= 30);
+  // The model's internal variables are particle fields of the run.
+  const std::string run_json = read_file(dir.file("out/run.json"));
+  CHECK(run_json.find("\"plastic_shear_strain\"") != std::string::npos);
+  CHECK(run_json.find("\"yielded\"") != std::string::npos);
 }

@@ -34,6 +34,7 @@ class DimensionalPhysics : public Physics {
   void checkpoint_written() override { impl_->checkpoint_written(); }
   void removing_particles(const ParticleRemoval& removal) override { impl_->removing_particles(removal); }
   std::optional<std::array<double, 3>> reaction(const BoundaryCondition& bc) const override { return impl_->reaction(bc); }
+  std::optional<RigidBodyMotion> rigid_body(const BoundaryCondition& bc) const override { return impl_->rigid_body(bc); }
   std::vector<std::pair<std::string, double>> statistics() const override { return impl_->statistics(); }
   std::vector<std::pair<std::string, const std::vector<double>*>> step_series() const override {
     return impl_->step_series();

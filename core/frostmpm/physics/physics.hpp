@@ -85,6 +85,15 @@ class Physics {
   /// material, [N] per metre of thickness in 2-D, for `reaction` probes; none when the
   /// physics does not track it.
   virtual std::optional<std::array<double, 3>> reaction(const BoundaryCondition& /*bc*/) const { return std::nullopt; }
+  /// A rigid body that a boundary condition drives into the material (a footing), for the
+  /// footing_* probes: how far it has moved along its direction of motion [m], the force with
+  /// which the material resists that motion [N, per m of thickness in 2-D] and the area it
+  /// presses on [m², m per m of thickness in 2-D].
+  struct RigidBodyMotion {
+    double displacement = 0, force = 0, contact_area = 0;
+  };
+  /// The motion of the rigid body `bc` drives; none for other conditions.
+  virtual std::optional<RigidBodyMotion> rigid_body(const BoundaryCondition& /*bc*/) const { return std::nullopt; }
   /// Counters for run.json (e.g. linear iterations); keys are free-form.
   virtual std::vector<std::pair<std::string, double>> statistics() const { return {}; }
   /// One value per step for run.json's `per_step` (e.g. a solver's iterations and final

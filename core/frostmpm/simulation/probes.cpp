@@ -99,7 +99,8 @@ void Probes::read(const ConfigNode* node, Sources sources) {
   resolved_ = YAML::Node(YAML::NodeType::Sequence);
   if (!node) return;
   static const std::vector<std::string> types = {"min",          "max",        "value_at", "integral",  "isotherm",
-                                                 "thaw_depth",   "displacement", "settlement", "reaction"};
+                                                 "thaw_depth",   "displacement", "settlement", "reaction",
+                                                 "footing_force", "footing_pressure", "footing_displacement"};
   const auto scalars = scalar_names();
   const auto& grid = *sources_.grid;
   const auto positions = sources_.particles->field("position");
@@ -196,7 +197,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         probe->start.push_back(positions[p * kDim + kDim - 1] + half[p * kDim + kDim - 1]);
       }
       item.finish({"type", "name", "over_time", "x_range"});
-    } else if (probe->type == "reaction") {
+    } else if (probe->type == "reaction" || probe->type.starts_with("footing_")) {
       const ConfigNode boundary = item.child("boundary");
       probe->boundary = boundary.as_string();
       const auto& named = sources_.boundaries;
@@ -208,15 +209,20 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         throw boundary.error("no boundary condition is named '" + probe->boundary + "'; named: " +
                              (names.empty() ? std::string("none (give one a name: key)") : join(names)));
       }
-      // Its value would be NaN all run.
-      if (!it->has_reaction) {
+      if (probe->type != "reaction") {
+        if (!it->is_rigid_body)
+          throw boundary.error("the " + it->label + " drives no rigid body; a " + probe->type +
+                               " probe names a condition of type footing");
+        item.finish({"type", "name", "over_time", "boundary"});
+      } else if (!it->has_reaction) {  // its value would be NaN all run
         const auto& types = sources_.reaction_types;
         throw boundary.error("the " + it->label + " reports no reaction force; of this scene's conditions, " +
                              (types.empty() ? std::string("none does")
                                             : "those of type " + join(types, ", ") + " do"));
+      } else {
+        probe->component = read_component(item.child("component"), kDim);
+        item.finish({"type", "name", "over_time", "boundary", "component"});
       }
-      probe->component = read_component(item.child("component"), kDim);
-      item.finish({"type", "name", "over_time", "boundary", "component"});
     } else if (probe->type == "thaw_depth") {
       if (std::find(scalars.begin(), scalars.end(), "liquid_saturation") == scalars.end())
         throw type.error("a thaw_depth probe reads liquid_saturation, which only the thermal physics has; add "
@@ -376,6 +382,11 @@ std::vector<double> Probes::evaluate() const {
       out.push_back(sum / double(probe->particles.size()));
     } else if (probe->type == "reaction") {
       out.push_back(sources_.reaction(probe->boundary)[probe->component]);
+    } else if (probe->type.starts_with("footing_")) {
+      const auto body = sources_.rigid_body(probe->boundary);
+      out.push_back(probe->type == "footing_force"      ? body.force
+                    : probe->type == "footing_pressure" ? body.force / body.contact_area
+                                                        : body.displacement);
     } else {
       // isotherm: distance from `from` to the first crossing of `value` along the line.
       // thaw_depth: to the last place where thawed material (S_l ≥ level) lies over frozen —

@@ -15,6 +15,10 @@
 //                    x_range), m, positive down
 //   reaction         one component of the force a boundary condition (named with `name:`)
 //                    exerts on the material, N per m of thickness in 2-D
+//   footing_force    the force with which the material resists a footing (a rigid body a
+//                    condition drives, named with `name:`), N per m in 2-D, positive resisting
+//   footing_pressure that force over the footing's contact area (width in 2-D), Pa
+//   footing_displacement  how far the footing has moved along its direction of motion, m
 #include <array>
 #include <functional>
 #include <memory>
@@ -39,6 +43,7 @@ class Probes {
     std::string name;
     std::string label;          ///< BoundaryCondition::label(), for messages
     bool has_reaction = false;  ///< its physics reports the force it exerts
+    bool is_rigid_body = false; ///< it drives a rigid body (footing_* probes)
   };
   /// What probes read: the particles (with their positions at the start), the transfer service,
   /// the grid, the named boundary conditions and the reaction of one.
@@ -49,6 +54,7 @@ class Probes {
     std::vector<NamedBoundary> boundaries;
     std::vector<std::string> reaction_types;  ///< types of the scene's conditions that have a reaction
     std::function<std::array<double, 3>(const std::string&)> reaction;
+    std::function<Physics::RigidBodyMotion(const std::string&)> rigid_body;
   };
 
   Probes();

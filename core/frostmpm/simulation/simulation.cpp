@@ -71,9 +71,11 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
       if (has_reaction && std::find(sources.reaction_types.begin(), sources.reaction_types.end(), bc.type) ==
                               sources.reaction_types.end())
         sources.reaction_types.push_back(bc.type);
-      if (!bc.name.empty()) sources.boundaries.push_back({bc.name, bc.label(), has_reaction});
+      if (!bc.name.empty())
+        sources.boundaries.push_back({bc.name, bc.label(), has_reaction, rigid_body_of(bc).has_value()});
     }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
+    sources.rigid_body = [this](const std::string& name) { return rigid_body(name); };
     const auto probes = root.optional_child("probes");
     probes_.read(probes ? &*probes : nullptr, std::move(sources));
     resolved_["probes"] = probes_.resolved();
@@ -179,6 +181,21 @@ std::optional<std::array<double, 3>> Simulation::reaction_of(const BoundaryCondi
   for (std::size_t i = 0; i < physics_.size(); ++i)
     if (physics_keys_[i] == owner) return physics_[i]->reaction(bc);
   return std::nullopt;
+}
+
+std::optional<Physics::RigidBodyMotion> Simulation::rigid_body_of(const BoundaryCondition& bc) const {
+  const std::string& owner = bc_owner_.at(bc.type);
+  for (std::size_t i = 0; i < physics_.size(); ++i)
+    if (physics_keys_[i] == owner) return physics_[i]->rigid_body(bc);
+  return std::nullopt;
+}
+
+Physics::RigidBodyMotion Simulation::rigid_body(const std::string& name) const {
+  for (const auto& bc : bcs_)
+    if (bc.name == name)
+      if (const auto body = rigid_body_of(bc)) return *body;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {nan, nan, nan};
 }
 
 std::array<double, 3> Simulation::reaction(const std::string& name) const {

@@ -171,6 +171,9 @@ class Simulation final : public Kernel<kDim> {
   std::optional<std::array<double, 3>> reaction_of(const BoundaryCondition& bc) const;
   /// The reaction force on the boundary condition named `name` (probes name only those that have one).
   std::array<double, 3> reaction(const std::string& name) const;
+  /// The rigid body a boundary condition drives (a footing), by condition and by name.
+  std::optional<Physics::RigidBodyMotion> rigid_body_of(const BoundaryCondition& bc) const;
+  Physics::RigidBodyMotion rigid_body(const std::string& name) const;
 
   const Registry& registry_;
   UniformGrid<kDim> grid_;

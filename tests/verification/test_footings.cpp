@@ -1,0 +1,142 @@
+// Rigid footings (boundary condition `footing`, probes footing_*) against closed forms: a smooth
+// footing compressing a laterally confined elastic column (oedometer: q = E_oed ln(H/(H − s)) for
+// a settlement s in the updated-Lagrangian limit), and Prandtl's rough strip footing on weightless Tresca soil,
+// q_u = (2 + π) c, with and without the volumetric-locking remedy, at two resolutions.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+using namespace frostmpm::test;
+
+namespace {
+
+std::string number(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
+
+CsvTable run_scene(const TempDir& dir, const std::string& scene, const std::vector<std::string>& sets,
+                   const std::string& name) {
+  std::string cmd = "run " + scene + " -o " + dir.file(name) + " --set output.progress=false";
+  for (const auto& s : sets) cmd += " --set '" + s + "'";
+  const auto r = run_frostmpm(cmd);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  return read_csv(dir.file(name + "/metrics.csv"));
+}
+
+}  // namespace
+
+TEST_CASE("smooth footing on a confined elastic column: the oedometric pressure, force = pressure x width, "
+          "displacement = the integral of its speed",
+          "[verification][mechanics][footing]") {
+  TempDir dir;
+  // H = 1 m, 0.1 m wide (rollers on both sides), E = 10 MPa, ν = 0.3: E_oed = 13.4615 MPa.
+  const std::string scene = dir.file("oedometer.yaml");
+  write_file(scene, R"yaml(task: simulation
+grid: {cells: [2, 21], cell_size: 0.05}
+time: {end: 0.5}
+physics:
+  mechanical: {local_damping: 0.1}
+materials:
+  soil:
+    porosity: 0.4
+    solid_density: 2650
+    water_density: 1000
+    mechanical_model: {model: linear_elastic, youngs_modulus: 1.0e7, poisson_ratio: 0.3}
+regions:
+  - shape: {box: {min: [0, 0], max: [0.1, 1.0]}}
+    material: soil
+boundary_conditions:
+  - {type: fixed, nodes: {face: y_min}}
+  - {type: roller, nodes: {face: x_min}}
+  - {type: roller, nodes: {face: x_max}}
+  - {type: footing, name: plate, nodes: {box: {min: [0, 1.0], max: [0.1, 1.05]}}, y: {expression: "-0.01 * min(t / 0.05, 1)"}, contact: smooth}
+output: {every: 0, metrics_every: 0.01}
+probes:
+  - {name: d, type: footing_displacement, boundary: plate}
+  - {name: F, type: footing_force, boundary: plate}
+  - {name: q, type: footing_pressure, boundary: plate}
+  - {name: Ry, type: reaction, boundary: plate, component: y}
+  - {name: s, type: settlement}
+)yaml");
+  const CsvTable t = run_scene(dir, scene, {}, "out");
+  const double E_oed = 1e7 * 0.7 / (1.3 * 0.4);
+  REQUIRE(E_oed == Approx(1.346154e7).epsilon(1e-6));
+  const auto time = t.column("time_s"), d = t.column("d"), F = t.column("F"), q = t.column("q"), R = t.column("Ry"),
+             s = t.column("s");
+  int checked = 0;
+  for (const auto& row : t.rows) {
+    const double tt = row[time];
+    // ∫ v dt of the ramp, then the constant speed; the footing moves as the material under it,
+    // with v at each step's start (first order: ½ (dv/dt) Δt t_ramp = 1.5e-6 m short over the ramp).
+    const double exact_d = tt <= 0.05 ? 0.01 * tt * tt / 0.1 : 0.01 * (tt - 0.025);
+    CHECK(row[d] == Approx(exact_d).margin(2e-6));
+    CHECK(row[F] == Approx(0.1 * row[q]).epsilon(1e-12));
+    CHECK(row[F] == Approx(-row[R]).epsilon(1e-12));  // the force on the material is downward
+    if (tt < 0.2) continue;  // past the ramp's transient
+    INFO("t = " << tt << " s, d = " << row[d] << " m, settlement " << row[s] << " m");
+    // The footing drives the node row at the column's top; the material's surface follows it
+    // within a few micrometres (its nodes stay where the grid has them).
+    CHECK(row[s] == Approx(row[d]).epsilon(0.01));
+    CHECK(row[q] == Approx(E_oed * std::log(1.0 / (1.0 - row[s]))).epsilon(0.01));
+    ++checked;
+  }
+  CHECK(checked >= 30);
+
+  // A restart carries the footing's travel: stopped at 0.25 s and resumed, the last row is the
+  // uninterrupted run's to the bit.
+  run_scene(dir, scene, {"time.end=0.25"}, "first_half");
+  const auto resumed = run_frostmpm("run --restart " + dir.file("first_half") + " --set time.end=0.5 --set output.progress=false");
+  INFO(resumed.output);
+  REQUIRE(resumed.exit_code == 0);
+  const CsvTable r = read_csv(dir.file("first_half/metrics.csv"));
+  REQUIRE(r.rows.back()[time] == t.rows.back()[time]);
+  CHECK(r.rows.back() == t.rows.back());
+}
+
+TEST_CASE("Prandtl's strip footing: the plateau pressure within 5 % of (2 + pi) c with the cell-averaged "
+          "volumetric strain at two resolutions, converging, and locked without it",
+          "[verification][mechanics][footing][mohr_coulomb]") {
+  TempDir dir;
+  const std::string scene = source_dir() + "/configs/verification/prandtl_footing.yaml";
+  const double c = 1e4, q_u = (2 + M_PI) * c;
+  REQUIRE(q_u == Approx(51415.93).epsilon(1e-6));
+  // The plateau: the mean pressure while the footing's face travels from h/4 to 5h/8 of the first
+  // cell (plastic from d ≈ 0.002 m; at d = h the face reaches the next node row, see the scene).
+  auto plateau_error = [&](double h, const std::string& volumetric) {
+    const int nx = int(std::lround(2.5 / h)), ny = int(std::lround(1.5 / h)) + 2;
+    const double end = 0.05 + 0.65 * h / 0.1;  // the ramp's 0.005 m, then 5h/8 + a margin at 0.1 m/s
+    const CsvTable t = run_scene(dir, scene,
+                                 {"grid.cells=[" + std::to_string(nx) + ", " + std::to_string(ny) + "]",
+                                  "grid.cell_size=" + number(h), "time.end=" + number(end),
+                                  "physics.mechanical.volumetric_strain=" + volumetric},
+                                 volumetric + std::to_string(nx));
+    const auto d = t.column("settlement"), q = t.column("pressure");
+    double sum = 0;
+    int n = 0;
+    for (const auto& row : t.rows)
+      if (row[d] >= h / 4 && row[d] <= 5 * h / 8) sum += row[q], ++n;
+    REQUIRE(n > 50);
+    return sum / n / q_u - 1.0;
+  };
+  const double coarse = plateau_error(1.0 / 16, "cell_average"), fine = plateau_error(1.0 / 32, "cell_average");
+  const double locked_coarse = plateau_error(1.0 / 16, "particle"), locked_fine = plateau_error(1.0 / 32, "particle");
+  WARN("Prandtl plateau error, cell_average: " << coarse << " (B/16), " << fine << " (B/32); particle (locked): "
+                                                << locked_coarse << ", " << locked_fine);
+  // Measured: +3.0 %, +1.6 % with the remedy; +21 %, +10 % without. MPM with a rough footing lands
+  // above the rigid-plastic value, approaching it as h shrinks.
+  CHECK(std::abs(coarse) < 0.05);
+  CHECK(std::abs(fine) < 0.05);
+  CHECK(fine > 0);
+  CHECK(std::log2(coarse / fine) > 0.5);  // converging, about first order
+  CHECK(locked_coarse > 0.15);            // locking: far above, and the remedy removes most of it
+  CHECK(locked_fine > 2 * fine);
+}
