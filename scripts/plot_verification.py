@@ -86,7 +86,7 @@ def prandtl(folders, png):
         scene = frostplot.run_summary(folder).get("resolved_scene", {})
         h = scene["grid"]["cell_size"][0]
         remedy = scene.get("physics", {}).get("mechanical", {}).get("volumetric_strain", "particle")
-        ax.plot(m["settlement"] / h, m["pressure"] / q_u, "-", lw=1, label=f"{cell_label(folder)}, {remedy}")
+        ax.plot(m["footing_displacement"] / h, m["footing_pressure"] / q_u, "-", lw=1, label=f"{cell_label(folder)}, {remedy}")
     ax.axhline(1.0, color="k", lw=0.8, label="(2 + π) c")
     ax.axvspan(0.25, 0.625, color="0.9", label="plateau read")
     ax.set(xlabel="settlement d / h (cells of travel)", ylabel="q / (2 + π) c", ylim=(0, 1.5),

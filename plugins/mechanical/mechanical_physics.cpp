@@ -630,20 +630,11 @@ void MechanicalPhysics<Dim>::average_volumetric_strain() {
   const auto x = position_.values();
   const auto vol = volume_.values();
   const std::size_t n = kernel_->particle_count();
-  std::size_t cells = 1;
-  for (int d = 0; d < Dim; ++d) cells *= std::size_t(grid.cells[d]);
   cell_of_.resize(n);
-  parallel_for(n, [&](std::size_t p) {
-    std::size_t index = 0;
-    for (int d = Dim - 1; d >= 0; --d) {
-      const int c = std::clamp(int(std::floor((x[p * Dim + d] - grid.origin[d]) / grid.spacing[d])), 0, grid.cells[d] - 1);
-      index = index * std::size_t(grid.cells[d]) + std::size_t(c);
-    }
-    cell_of_[p] = index;
-  });
+  parallel_for(n, [&](std::size_t p) { cell_of_[p] = grid.cell_of(x.data() + p * Dim); });
   // Sums in particle order, one thread: the same whatever the thread count.
-  cell_volume_.assign(cells, 0.0);
-  cell_strain_.assign(cells, 0.0);
+  cell_volume_.assign(grid.cell_count(), 0.0);
+  cell_strain_.assign(grid.cell_count(), 0.0);
   for (std::size_t p = 0; p < n; ++p) {
     const double* de = strain_increment_.data() + 6 * p;
     cell_volume_[cell_of_[p]] += vol[p];

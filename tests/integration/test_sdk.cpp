@@ -42,6 +42,23 @@ std::string build_template(const TempDir& dir, const std::string& example) {
   return plugin_build;
 }
 
+/// `frostmpm test-model KIND/NAME` with the plugin's folder on the search path (and `--set`
+/// overrides): exit 0 and "contract kept".
+void require_contract_kept(const std::string& plugin_build, const std::string& model, const std::string& sets = "") {
+  const auto r = run_frostmpm("test-model " + model + " --plugin-path " + plugin_build + sets);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(r.output.find(model + ": contract kept") != std::string::npos);
+}
+
+/// Runs the copied example's scene.yaml into dir/out with the plugin on FROSTMPM_PLUGIN_PATH.
+void run_example_scene(const TempDir& dir, const std::string& plugin_build) {
+  const auto r = run_command("FROSTMPM_PLUGIN_PATH=" + plugin_build + " " + frostmpm_exe() + " run " +
+                             dir.file("template/scene.yaml") + " -o " + dir.file("out"));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+}
+
 }  // namespace
 
 TEST_CASE("an out-of-tree SFCC plugin builds against the installed SDK and runs", "[sdk]") {
@@ -85,15 +102,8 @@ TEST_CASE("an out-of-tree constitutive model builds against the installed SDK, k
   REQUIRE(fs::exists(plugin_build + "/libmy_constitutive.so"));
 
   // The author's contract check, as the template's README runs it.
-  auto r = run_frostmpm("test-model mechanical_model/temperature_elastic --plugin-path " + plugin_build);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  REQUIRE(r.output.find("mechanical_model/temperature_elastic: contract kept") != std::string::npos);
-
-  const std::string env = "FROSTMPM_PLUGIN_PATH=" + plugin_build + " ";
-  r = run_command(env + frostmpm_exe() + " run " + dir.file("template/scene.yaml") + " -o " + dir.file("out"));
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
+  require_contract_kept(plugin_build, "mechanical_model/temperature_elastic");
+  run_example_scene(dir, plugin_build);
   // The two-layer small-strain settlement of the scene's header: 0.542 mm with the frozen top
   // (0.725 mm if it were thawed); the base carries the column's weight.
   const CsvTable metrics = read_csv(dir.file("out/metrics.csv"));
@@ -113,20 +123,10 @@ TEST_CASE("an out-of-tree plasticity model (Drucker-Prager) keeps its contract a
 
   // The contract, as the example's README runs it: the picked parameters (and each at 1 % and
   // 99 % of its range), then the scene's soil; both return to the cone and to its apex.
-  auto r = run_frostmpm("test-model mechanical_model/drucker_prager --plugin-path " + plugin_build);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  REQUIRE(r.output.find("mechanical_model/drucker_prager: contract kept") != std::string::npos);
-  r = run_frostmpm("test-model mechanical_model/drucker_prager --plugin-path " + plugin_build +
-                   " --set youngs_modulus=4e7 --set cohesion=1e4 --set friction_angle=30 --set dilation_angle=30");
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  REQUIRE(r.output.find("mechanical_model/drucker_prager: contract kept") != std::string::npos);
-
-  const std::string env = "FROSTMPM_PLUGIN_PATH=" + plugin_build + " ";
-  r = run_command(env + frostmpm_exe() + " run " + dir.file("template/scene.yaml") + " -o " + dir.file("out"));
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
+  require_contract_kept(plugin_build, "mechanical_model/drucker_prager");
+  require_contract_kept(plugin_build, "mechanical_model/drucker_prager",
+                        " --set youngs_modulus=4e7 --set cohesion=1e4 --set friction_angle=30 --set dilation_angle=30");
+  run_example_scene(dir, plugin_build);
   // Plane-strain unconfined compression with associated flow: the plane-strain-matched cone is
   // Mohr-Coulomb's, so the axial stress levels off at 2c cos(phi)/(1 - sin(phi)) (c = 10 kPa,
   // phi = 30 degrees). sigma_v = -platen reaction / current width; the width follows the outermost

@@ -9,30 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace frostmpm::test;
 
-namespace {
-
-std::string number(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
-
-CsvTable run_scene(const TempDir& dir, const std::string& scene, const std::vector<std::string>& sets,
-                   const std::string& name) {
-  std::string cmd = "run " + scene + " -o " + dir.file(name) + " --set output.progress=false";
-  for (const auto& s : sets) cmd += " --set '" + s + "'";
-  const auto r = run_frostmpm(cmd);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  return read_csv(dir.file(name + "/metrics.csv"));
-}
-
-}  // namespace
 
 TEST_CASE("smooth footing on a confined elastic column: the oedometric pressure, force = pressure x width, "
           "displacement = the integral of its speed",
@@ -106,7 +87,7 @@ TEST_CASE("Prandtl's strip footing: the plateau pressure within 5 % of (2 + pi) 
           "volumetric strain at two resolutions, converging, and locked without it",
           "[verification][mechanics][footing][mohr_coulomb]") {
   TempDir dir;
-  const std::string scene = source_dir() + "/configs/verification/prandtl_footing.yaml";
+  const std::string scene = verification_scene("prandtl_footing.yaml");
   const double c = 1e4, q_u = (2 + M_PI) * c;
   REQUIRE(q_u == Approx(51415.93).epsilon(1e-6));
   // The plateau: the mean pressure while the footing's face travels from h/4 to 5h/8 of the first
@@ -116,10 +97,10 @@ TEST_CASE("Prandtl's strip footing: the plateau pressure within 5 % of (2 + pi) 
     const double end = 0.05 + 0.65 * h / 0.1;  // the ramp's 0.005 m, then 5h/8 + a margin at 0.1 m/s
     const CsvTable t = run_scene(dir, scene,
                                  {"grid.cells=[" + std::to_string(nx) + ", " + std::to_string(ny) + "]",
-                                  "grid.cell_size=" + number(h), "time.end=" + number(end),
+                                  "grid.cell_size=" + exact_number(h), "time.end=" + exact_number(end),
                                   "physics.mechanical.volumetric_strain=" + volumetric},
                                  volumetric + std::to_string(nx));
-    const auto d = t.column("settlement"), q = t.column("pressure");
+    const auto d = t.column("footing_displacement"), q = t.column("footing_pressure");
     double sum = 0;
     int n = 0;
     for (const auto& row : t.rows)

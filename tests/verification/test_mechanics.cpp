@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 #include "verification/analytic/poromechanics.hpp"
 
@@ -20,31 +21,11 @@ namespace an = frostmpm::analytic;
 
 namespace {
 
-std::string number(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
-
-/// Runs configs/verification/<scene> (a paper scene as "../paper/<scene>") with overrides;
-/// returns metrics.csv.
-CsvTable run_scene(const TempDir& dir, const std::string& scene, const std::vector<std::string>& sets,
-                   const std::string& name) {
-  std::string cmd = "run " + source_dir() + "/configs/verification/" + scene + " -o " + dir.file(name) +
-                    " --set output.progress=false";
-  for (const auto& s : sets) cmd += " --set '" + s + "'";
-  const auto r = run_frostmpm(cmd);
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
-  return read_csv(dir.file(name + "/metrics.csv"));
-}
-
 /// A column of `cells` cells of height 1 m and one cell width.
 std::vector<std::string> column(int cells, std::vector<std::string> more = {}) {
   const double h = 1.0 / cells;
-  std::vector<std::string> sets = {"grid.cells=[1, " + std::to_string(cells) + "]", "grid.cell_size=" + number(h),
-                                   "regions.0.shape={box: {min: [0, 0], max: [" + number(h) + ", 1.0]}}"};
+  std::vector<std::string> sets = {"grid.cells=[1, " + std::to_string(cells) + "]", "grid.cell_size=" + exact_number(h),
+                                   "regions.0.shape={box: {min: [0, 0], max: [" + exact_number(h) + ", 1.0]}}"};
   sets.insert(sets.end(), more.begin(), more.end());
   return sets;
 }
@@ -80,7 +61,7 @@ TEST_CASE("self-weight column: settlement converges to the closed form, the base
   const double s_large = large_strain_settlement();
   std::vector<double> settlement_error, stress_error;
   for (int cells : {10, 20, 40}) {
-    const auto t = run_scene(dir, "self_weight_column.yaml", column(cells, {"time.end=3"}), "sw" + std::to_string(cells));
+    const auto t = run_scene(dir, verification_scene("self_weight_column.yaml"), column(cells, {"time.end=3"}), "sw" + std::to_string(cells));
     const auto& last = t.rows.back();
     const double s = last[t.column("settlement")];
     settlement_error.push_back((s - s_large) / s_large);
@@ -106,7 +87,7 @@ TEST_CASE("self-weight column loaded suddenly, undamped: the surface swings to 2
   REQUIRE(kColumn.period() == Approx(0.15418).epsilon(1e-4));
   std::vector<double> time_error;
   for (int cells : {10, 20, 40}) {
-    const auto t = run_scene(dir, "self_weight_column.yaml",
+    const auto t = run_scene(dir, verification_scene("self_weight_column.yaml"),
                              column(cells, {"time.end=0.12", "physics.mechanical.local_damping=0", "output.metrics_every=0"}),
                              "swd" + std::to_string(cells));
     double peak = 0, at = 0;
@@ -132,14 +113,14 @@ TEST_CASE("vibrating bar: period and free-end amplitude of the first mode", "[ve
   auto sets = [](double h, double v0) {
     const int cells = static_cast<int>(std::lround(30.0 / h));
     return std::vector<std::string>{
-        "grid.cells=[" + std::to_string(cells) + ", 1]", "grid.cell_size=" + number(h),
-        "regions.0.shape={box: {min: [0, 0], max: [25, " + number(h) + "]}}",
-        "regions.0.initial={solid_velocity.x: {expression: \"" + number(v0) + "*sin(pi*x/50)\"}}",
-        "probes.0.point=[25, " + number(h / 2) + "]", "output.metrics_every=0.01", "time.end=11"};
+        "grid.cells=[" + std::to_string(cells) + ", 1]", "grid.cell_size=" + exact_number(h),
+        "regions.0.shape={box: {min: [0, 0], max: [25, " + exact_number(h) + "]}}",
+        "regions.0.initial={solid_velocity.x: {expression: \"" + exact_number(v0) + "*sin(pi*x/50)\"}}",
+        "probes.0.point=[25, " + exact_number(h / 2) + "]", "output.metrics_every=0.01", "time.end=11"};
   };
   // v0 = 0.1 m/s (1 % strain): period and amplitude within a per cent.
   for (double h : {2.5, 1.25, 0.625}) {
-    const auto t = run_scene(dir, "vibrating_bar.yaml", sets(h, 0.1), "bar" + number(h));
+    const auto t = run_scene(dir, verification_scene("vibrating_bar.yaml"), sets(h, 0.1), "bar" + exact_number(h));
     double amplitude = 0;
     for (const auto& row : t.rows) amplitude = std::max(amplitude, std::abs(row[t.column("u_end")]));
     // The probe follows the particle nearest the end, a quarter cell inside the bar.
@@ -154,7 +135,7 @@ TEST_CASE("vibrating bar: period and free-end amplitude of the first mode", "[ve
   std::vector<double> errors;
   for (double h : {2.5, 1.25, 0.625}) {
     const double v0 = 1e-3;
-    const auto t = run_scene(dir, "vibrating_bar.yaml", sets(h, v0), "barl" + number(h));
+    const auto t = run_scene(dir, verification_scene("vibrating_bar.yaml"), sets(h, v0), "barl" + exact_number(h));
     const double x = 25.0 - h / 4;
     double e2 = 0, u2 = 0;
     for (const auto& row : t.rows) {
@@ -185,9 +166,9 @@ TEST_CASE("Terzaghi consolidation with a moving skeleton: settlement U(T_v) with
   for (double q : {1e4, 1e2}) {
     std::vector<std::vector<double>> errors;
     for (int cells : {10, 20, 40}) {
-      const auto t = run_scene(dir, "terzaghi_consolidation.yaml",
-                               column(cells, {"time.end=5", "boundary_conditions.3.value=" + number(q)}),
-                               "tz" + number(q) + "_" + std::to_string(cells));
+      const auto t = run_scene(dir, verification_scene("terzaghi_consolidation.yaml"),
+                               column(cells, {"time.end=5", "boundary_conditions.3.value=" + exact_number(q)}),
+                               "tz" + exact_number(q) + "_" + std::to_string(cells));
       const double drained = q / kTerzaghiOedometric;
       errors.emplace_back();
       for (double T : Tv) {
@@ -218,9 +199,9 @@ TEST_CASE("mass scaling: Terzaghi's settlement does not change while the kinetic
   TempDir dir;
   const std::vector<double> Tv = {0.05, 0.2, 0.5};
   auto degrees = [&](double scaling, double& kinetic_to_work) {
-    const std::string name = "scaled" + number(scaling);
-    const auto t = run_scene(dir, "terzaghi_consolidation.yaml",
-                             column(20, {"time.end=5", "time.mass_scaling=" + number(scaling)}), name);
+    const std::string name = "scaled" + exact_number(scaling);
+    const auto t = run_scene(dir, verification_scene("terzaghi_consolidation.yaml"),
+                             column(20, {"time.end=5", "time.mass_scaling=" + exact_number(scaling)}), name);
     kinetic_to_work = run_counter(dir.file(name), "mechanical.kinetic_to_work_max");
     std::vector<double> U;
     for (double T : Tv) {
@@ -257,7 +238,7 @@ TEST_CASE("undrained limit: with a nearly impermeable soil the water carries a s
           "not settle", "[verification][mechanics][hydraulic]") {
   TempDir dir;
   // K = 1e-12 m/s: c_v = 1.4e-10 m²/s, nothing drains in 0.5 s.
-  const auto t = run_scene(dir, "terzaghi_consolidation.yaml",
+  const auto t = run_scene(dir, verification_scene("terzaghi_consolidation.yaml"),
                            column(20, {"time.end=0.5", "materials.soil.absolute_permeability.k0=1.0e-12",
                                        "output.metrics_every=0.05"}),
                            "undrained");
@@ -284,10 +265,10 @@ TEST_CASE("Mandel's problem: the pore pressure at the centre overshoots (Mandel�
   std::vector<double> peak_error;
   for (double h : {0.1, 0.05}) {
     const int cx = static_cast<int>(std::lround(1.2 / h)), cy = static_cast<int>(std::lround(0.5 / h));
-    const auto t = run_scene(dir, "mandel.yaml",
+    const auto t = run_scene(dir, verification_scene("mandel.yaml"),
                              {"grid.cells=[" + std::to_string(cx) + ", " + std::to_string(cy) + "]",
-                              "grid.cell_size=" + number(h), "time.end=10", "output.metrics_every=0.1"},
-                             "mandel" + number(h));
+                              "grid.cell_size=" + exact_number(h), "time.end=10", "output.metrics_every=0.1"},
+                             "mandel" + exact_number(h));
     double best = 0, best_T = 0;
     for (const auto& row : t.rows) {
       const double T = c * row[t.column("time_s")], p = row[t.column("p_centre")] / 1e4;
@@ -323,7 +304,7 @@ TEST_CASE("Neumann thaw in a column translated rigidly across the grid: the same
   const double h = 0.01;
   auto sets = [&](bool moving) {
     std::vector<std::string> s = {
-        "grid.cells=[12, 150]", "grid.cell_size=" + number(h),
+        "grid.cells=[12, 150]", "grid.cell_size=" + exact_number(h),
         "regions.0.shape={box: {min: [0, 0], max: [0.06, 1.5]}}",
         "probes.0.from=[0.055, 1.5]", "probes.0.to=[0.055, 0.0]",
         "probes.4.from=[0.055, 1.5]", "probes.4.to=[0.055, 0.0]"};
@@ -331,12 +312,12 @@ TEST_CASE("Neumann thaw in a column translated rigidly across the grid: the same
       s.push_back("physics.mechanical={}");
       s.push_back("materials.soil.mechanical_model={model: linear_elastic, youngs_modulus: 1.0e-6, poisson_ratio: 0}");
       s.push_back("boundary_conditions=[{type: temperature, nodes: {face: y_max}, value: 5.0}, {type: velocity, nodes: "
-                  "{box: {min: [0, 0], max: [0.12, 1.5]}}, x: " + number(0.05 / 86400) + ", y: 0}]");
+                  "{box: {min: [0, 0], max: [0.12, 1.5]}}, x: " + exact_number(0.05 / 86400) + ", y: 0}]");
     }
     return s;
   };
-  const auto rest = run_scene(dir, "neumann_thaw.yaml", sets(false), "rest");
-  const auto moved = run_scene(dir, "neumann_thaw.yaml", sets(true), "moved");
+  const auto rest = run_scene(dir, verification_scene("neumann_thaw.yaml"), sets(false), "rest");
+  const auto moved = run_scene(dir, verification_scene("neumann_thaw.yaml"), sets(true), "moved");
   const double front_rest = rest.rows.back()[rest.column("half_thawed_depth")];
   const double front_moved = moved.rows.back()[moved.column("half_thawed_depth")];
   std::printf("Neumann thaw, h = %.2g m: S_l = ½ front %.5f m at rest, %.5f m moved 0.05 m (%+.3f %%)\n", h, front_rest,
@@ -363,11 +344,11 @@ TEST_CASE("Morgenstern–Nixon thaw consolidation: settlement and excess pore pr
     std::vector<double> errors;
     for (int cells : {30, 60}) {
       const double h = 0.3 / cells;
-      const std::string name = "mn" + number(c.R) + "_" + std::to_string(cells);
-      const auto t = run_scene(dir, "thaw_consolidation_mn.yaml",
-                               {"time.end=" + number(t_end), "grid.cells=[1, " + std::to_string(cells) + "]",
-                                "grid.cell_size=" + number(h), "regions.0.shape.box.max=[" + number(h) + ", 0.3]",
-                                "materials.soil.absolute_permeability.k0=" + number(c.k0)},
+      const std::string name = "mn" + exact_number(c.R) + "_" + std::to_string(cells);
+      const auto t = run_scene(dir, verification_scene("thaw_consolidation_mn.yaml"),
+                               {"time.end=" + exact_number(t_end), "grid.cells=[1, " + std::to_string(cells) + "]",
+                                "grid.cell_size=" + exact_number(h), "regions.0.shape.box.max=[" + exact_number(h) + ", 0.3]",
+                                "materials.soil.absolute_permeability.k0=" + exact_number(c.k0)},
                                name);
       const auto& last = t.rows.back();
       REQUIRE(last[t.column("time_s")] == Approx(t_end));
@@ -403,7 +384,7 @@ TEST_CASE("rock freezing around a borehole (coarse): thermal contraction before 
     std::vector<std::string> sets = {"time.end=7200", "grid.cells=[23, 15]", "grid.cell_size=0.01",
                                      "boundary_conditions.0.particles.disk.radius=0.028", "output.metrics_every=300"};
     sets.insert(sets.end(), more.begin(), more.end());
-    return run_scene(dir, "../paper/rock_freezing.yaml", sets, name);
+    return run_scene(dir, verification_scene("../paper/rock_freezing.yaml"), sets, name);
   };
   struct Summary {
     double contraction = 0, frozen_pressure = 0;  // min ε_rr at A while T_A > 0; max p_A once T_A < 0

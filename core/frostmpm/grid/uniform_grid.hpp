@@ -4,6 +4,7 @@
 // shape functions whose support reaches past the domain (cubic B-splines).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -45,6 +46,20 @@ struct UniformGrid {
     std::array<double, Dim> x{};
     for (int d = 0; d < Dim; ++d) x[d] = origin[d] + ijk[d] * spacing[d];
     return x;
+  }
+  std::size_t cell_count() const {
+    std::size_t n = 1;
+    for (int d = 0; d < Dim; ++d) n *= static_cast<std::size_t>(cells[d]);
+    return n;
+  }
+  /// Linear index of the domain cell holding point x (points outside go to the nearest cell).
+  std::size_t cell_of(const double* x) const {
+    std::size_t index = 0;
+    for (int d = Dim - 1; d >= 0; --d) {
+      const int c = std::clamp(static_cast<int>(std::floor((x[d] - origin[d]) / spacing[d])), 0, cells[d] - 1);
+      index = index * static_cast<std::size_t>(cells[d]) + static_cast<std::size_t>(c);
+    }
+    return index;
   }
   double cell_volume() const {
     double v = 1;

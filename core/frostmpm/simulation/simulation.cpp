@@ -67,12 +67,13 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
     sources.particles = &particles_;
     sources.transfer = &transfer_;
     for (const auto& bc : bcs_) {
-      const bool has_reaction = reaction_of(bc).has_value();
+      const Physics& owner = owner_of(bc);
+      const bool has_reaction = owner.reaction(bc).has_value();
       if (has_reaction && std::find(sources.reaction_types.begin(), sources.reaction_types.end(), bc.type) ==
                               sources.reaction_types.end())
         sources.reaction_types.push_back(bc.type);
       if (!bc.name.empty())
-        sources.boundaries.push_back({bc.name, bc.label(), has_reaction, rigid_body_of(bc).has_value()});
+        sources.boundaries.push_back({bc.name, bc.label(), has_reaction, owner.rigid_body(bc).has_value()});
     }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
     sources.rigid_body = [this](const std::string& name) { return rigid_body(name); };
@@ -176,34 +177,29 @@ std::string Simulation::describe_particle(std::size_t p) const {
   return out.str();
 }
 
-std::optional<std::array<double, 3>> Simulation::reaction_of(const BoundaryCondition& bc) const {
+const Physics& Simulation::owner_of(const BoundaryCondition& bc) const {
   const std::string& owner = bc_owner_.at(bc.type);
   for (std::size_t i = 0; i < physics_.size(); ++i)
-    if (physics_keys_[i] == owner) return physics_[i]->reaction(bc);
-  return std::nullopt;
+    if (physics_keys_[i] == owner) return *physics_[i];
+  throw std::logic_error("boundary condition type '" + bc.type + "' has no physics");
 }
 
-std::optional<Physics::RigidBodyMotion> Simulation::rigid_body_of(const BoundaryCondition& bc) const {
-  const std::string& owner = bc_owner_.at(bc.type);
-  for (std::size_t i = 0; i < physics_.size(); ++i)
-    if (physics_keys_[i] == owner) return physics_[i]->rigid_body(bc);
-  return std::nullopt;
-}
-
-Physics::RigidBodyMotion Simulation::rigid_body(const std::string& name) const {
+const BoundaryCondition& Simulation::named_condition(const std::string& name) const {
   for (const auto& bc : bcs_)
-    if (bc.name == name)
-      if (const auto body = rigid_body_of(bc)) return *body;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {nan, nan, nan};
+    if (bc.name == name) return bc;
+  throw std::logic_error("no boundary condition is named '" + name + "'");  // probes check names when read
 }
 
 std::array<double, 3> Simulation::reaction(const std::string& name) const {
-  for (const auto& bc : bcs_)
-    if (bc.name == name)
-      if (const auto force = reaction_of(bc)) return *force;
-  return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
-          std::numeric_limits<double>::quiet_NaN()};
+  const BoundaryCondition& bc = named_condition(name);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return owner_of(bc).reaction(bc).value_or(std::array<double, 3>{nan, nan, nan});
+}
+
+Physics::RigidBodyMotion Simulation::rigid_body(const std::string& name) const {
+  const BoundaryCondition& bc = named_condition(name);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return owner_of(bc).rigid_body(bc).value_or(Physics::RigidBodyMotion{nan, nan, nan});
 }
 
 // ---- the resolved step ----------------------------------------------------------------------------

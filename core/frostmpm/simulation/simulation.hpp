@@ -167,12 +167,13 @@ class Simulation final : public Kernel<kDim> {
   void save_checkpoint(const std::string& dir, LoopState& loop, const SceneSource& scene);
   /// Kernel state, particle fields and persistent arrays from <dir>/checkpoint.h5.
   LoopState restore_checkpoint(const std::string& dir);
-  /// The force `bc` exerts on the material, from the physics owning it; none when it does not track it.
-  std::optional<std::array<double, 3>> reaction_of(const BoundaryCondition& bc) const;
-  /// The reaction force on the boundary condition named `name` (probes name only those that have one).
+  /// The physics owning the condition's type (it reports the condition's reaction, rigid body).
+  const Physics& owner_of(const BoundaryCondition& bc) const;
+  /// The boundary condition with this `name:` (probes name only conditions that exist).
+  const BoundaryCondition& named_condition(const std::string& name) const;
+  /// The reaction force of the condition named `name`, and the rigid body it drives (a footing);
+  /// NaN when its physics does not report them (probes name only those that do).
   std::array<double, 3> reaction(const std::string& name) const;
-  /// The rigid body a boundary condition drives (a footing), by condition and by name.
-  std::optional<Physics::RigidBodyMotion> rigid_body_of(const BoundaryCondition& bc) const;
   Physics::RigidBodyMotion rigid_body(const std::string& name) const;
 
   const Registry& registry_;
