@@ -4,13 +4,16 @@
     /usr/bin/python3 scripts/plot_verification.py terzaghi OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py mandel OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py prandtl OUT [OUT ...] [--png FILE]
+    /usr/bin/python3 scripts/plot_verification.py reissner OUT [OUT ...] [--png FILE]
 
 terzaghi: configs/verification/terzaghi_consolidation.yaml runs (any cell sizes): the degree of
 consolidation U = settlement / (q H / E_oed) and the base pore pressure against Terzaghi's series
 (c_v = 0.1 m²/s, T_v = t / 10 s). mandel: configs/verification/mandel.yaml runs: p(0, t)/p0 at the
 centre against Mandel's series for ν = 0.3 (T = t / 50 s), with the Mandel–Cryer overshoot.
 prandtl: configs/verification/prandtl_footing.yaml runs: the footing pressure over (2 + π) c
-against the settlement in cells, labelled with the cell size and `volumetric_strain`.
+against the settlement in cells, labelled with the cell size and `volumetric_strain`. reissner:
+configs/verification/reissner_footing.yaml runs: the footing pressure over c N_c + q0 N_q
+(φ = 20°) against the settlement in mm, with the window the test averages.
 Each OUT is a run folder; the legend shows its cell size from run.json.
 """
 import argparse
@@ -78,6 +81,15 @@ def mandel(folders, png):
     frostplot.save(fig, png)
 
 
+def finish_footing(fig, ax, png, closed_form, window, xlabel, title):
+    """The closed form's line, the window the test averages, labels; saved to png."""
+    ax.axhline(1.0, color="k", lw=0.8, label=closed_form)
+    ax.axvspan(*window, color="0.9", label="plateau read")
+    ax.set(xlabel=xlabel, ylabel=f"q / {closed_form}", ylim=(0, 1.5), title=title)
+    ax.legend(fontsize=8)
+    frostplot.save(fig, png)
+
+
 def prandtl(folders, png):
     q_u = (2 + np.pi) * 1e4
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
@@ -87,23 +99,34 @@ def prandtl(folders, png):
         h = scene["grid"]["cell_size"][0]
         remedy = scene.get("physics", {}).get("mechanical", {}).get("volumetric_strain", "particle")
         ax.plot(m["footing_displacement"] / h, m["footing_pressure"] / q_u, "-", lw=1, label=f"{cell_label(folder)}, {remedy}")
-    ax.axhline(1.0, color="k", lw=0.8, label="(2 + π) c")
-    ax.axvspan(0.25, 0.625, color="0.9", label="plateau read")
-    ax.set(xlabel="settlement d / h (cells of travel)", ylabel="q / (2 + π) c", ylim=(0, 1.5),
-           title="Prandtl's rough strip footing on Tresca soil")
-    ax.legend(fontsize=8)
-    frostplot.save(fig, png)
+    finish_footing(fig, ax, png, "(2 + π) c", (0.25, 0.625), "settlement d / h (cells of travel)",
+                   "Prandtl's rough strip footing on Tresca soil")
+
+
+def reissner(folders, png):
+    phi = np.radians(20.0)
+    n_q = np.exp(np.pi * np.tan(phi)) * np.tan(np.pi / 4 + phi / 2) ** 2
+    q_u = 1e4 * (n_q - 1) / np.tan(phi) + 1e4 * n_q
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for folder in folders:
+        m = metrics(folder)
+        d, q = m["footing_displacement"], m["footing_pressure"] / q_u
+        window = (d >= 0.008) & (d <= 0.028)
+        line, = ax.plot(1e3 * d, q, "-", lw=1, label=cell_label(folder))
+        ax.hlines(q[window].mean(), 8, 28, colors=line.get_color(), linestyles="--", lw=1)
+    finish_footing(fig, ax, png, "(c N_c + q0 N_q)", (8, 28), "settlement d [mm] (dashed: the mean read)",
+                   "Prandtl–Reissner footing: c = 10 kPa, φ = ψ = 20°, q0 = 10 kPa")
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl"])
+    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl", "reissner"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png)")
     args = parser.parse_args()
     png = args.png or f"{args.figure}.png"
-    {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl}[args.figure](args.folders, png)
+    {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl, "reissner": reissner}[args.figure](args.folders, png)
     print(f"wrote {png}")
 
 

@@ -125,8 +125,8 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
   s.choice("volumetric_strain", {"particle", "cell_average"},
            "the volumetric strain increment the constitutive model sees: each particle's own, or the "
            "volume-weighted mean over the particles in its grid cell (cell_average: a remedy for the volumetric "
-           "locking of nearly incompressible or isochoric plastic flow, Mast et al. 2012; the deviatoric part "
-           "and the particle's volume stay its own)")
+           "locking of nearly incompressible or isochoric plastic flow, Mast et al. 2012, with the nodal forces "
+           "taking the cell's mean stress as B-bar does; the deviatoric part and the particle's volume stay its own)")
       .defaults_to("particle");
   s.choice("objective_rate", {"jaumann", "none"},
            "stress rate: Jaumann (objective, large rotations) or none (small-strain comparison)")
@@ -260,12 +260,17 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
                                         shear_.write()};
   for (auto& h : variables_start_) start_reads.push_back(h.read());
   for (auto& h : variables_) start_writes.push_back(h.write());
+  std::vector<FieldRef> predict_reads = {node_velocity_.read(),         stress_.read(),
+                                         half_size_.read(),             node_pressure_.optional_read(),
+                                         liquid_drag_.optional_read(),  liquid_reaction_.optional_read(),
+                                         volume_.read(),                porosity_.read(),
+                                         saturation_.optional_read()};
+  if (cell_average_) predict_reads.push_back(position_.read());  // the cells of the mean stress
   return {
       {"mechanical.map_to_grid", Phase::MapToGrid, start_reads, start_writes, [this] { map_to_grid(); }},
       {"mechanical.predict",
        Phase::PredictMomentum,
-       {node_velocity_.read(), stress_.read(), half_size_.read(), node_pressure_.optional_read(), liquid_drag_.optional_read(),
-        liquid_reaction_.optional_read(), volume_.read(), porosity_.read(), saturation_.optional_read()},
+       predict_reads,
        {node_predicted_.write(), node_mobility_.write(), node_group_.write()},
        [this] { predict(); }},
       {"mechanical.correct",
@@ -620,30 +625,42 @@ void MechanicalPhysics<Dim>::update_stress() {
     report_failure(std::size_t(first - failed_.begin()));
 }
 
-/// The volumetric part of every particle's strain increment replaced by the volume-weighted mean
-/// of the kinematic volumetric increments in its grid cell (its own thermal strain still taken
-/// off): linear and GIMP shape functions give each cell too few independent volume changes for
-/// isochoric flow, and the mean over the cell relaxes that constraint as a B-bar element does.
+/// The volume-weighted mean of value(p) over the particles of each grid cell, into cell_mean_
+/// (cell_of_ and cell_volume_ follow the current positions). The sums run in particle order on
+/// one thread: the same whatever the thread count.
 template <int Dim>
-void MechanicalPhysics<Dim>::average_volumetric_strain() {
+template <class Value>
+void MechanicalPhysics<Dim>::average_over_cells(Value value) {
   const auto& grid = kernel_->grid();
   const auto x = position_.values();
   const auto vol = volume_.values();
   const std::size_t n = kernel_->particle_count();
   cell_of_.resize(n);
   parallel_for(n, [&](std::size_t p) { cell_of_[p] = grid.cell_of(x.data() + p * Dim); });
-  // Sums in particle order, one thread: the same whatever the thread count.
   cell_volume_.assign(grid.cell_count(), 0.0);
-  cell_strain_.assign(grid.cell_count(), 0.0);
+  cell_mean_.assign(grid.cell_count(), 0.0);
   for (std::size_t p = 0; p < n; ++p) {
-    const double* de = strain_increment_.data() + 6 * p;
     cell_volume_[cell_of_[p]] += vol[p];
-    cell_strain_[cell_of_[p]] += vol[p] * (de[0] + de[1] + de[2] + 3.0 * thermal_strain_[p]);
+    cell_mean_[cell_of_[p]] += vol[p] * value(p);
   }
-  parallel_for(n, [&](std::size_t p) {
+  for (std::size_t c = 0; c < cell_mean_.size(); ++c)
+    if (cell_volume_[c] > 0) cell_mean_[c] /= cell_volume_[c];
+}
+
+/// The volumetric part of every particle's strain increment replaced by the volume-weighted mean
+/// of the kinematic volumetric increments in its grid cell (its own thermal strain still taken
+/// off): linear and GIMP shape functions give each cell too few independent volume changes for
+/// isochoric flow, and the mean over the cell relaxes that constraint as a B-bar element does.
+/// predict() closes the B-bar form with the cell's mean stress in the nodal forces.
+template <int Dim>
+void MechanicalPhysics<Dim>::average_volumetric_strain() {
+  average_over_cells([&](std::size_t p) {
+    const double* de = strain_increment_.data() + 6 * p;
+    return de[0] + de[1] + de[2] + 3.0 * thermal_strain_[p];
+  });
+  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     double* de = strain_increment_.data() + 6 * p;
-    const std::size_t c = cell_of_[p];
-    const double mean = cell_strain_[c] / cell_volume_[c] - 3.0 * thermal_strain_[p];
+    const double mean = cell_mean_[cell_of_[p]] - 3.0 * thermal_strain_[p];
     const double shift = (mean - (de[0] + de[1] + de[2])) / 3.0;
     for (int i = 0; i < 3; ++i) de[i] += shift;
   });
@@ -681,6 +698,19 @@ void MechanicalPhysics<Dim>::predict() {
   double* force = force_.data();
   double* weight = weight_.data();
   double* drag = drag_.data();
+  // B-bar's other half: the strains saw the cell's mean volumetric increment, so the forces see
+  // the cell's mean stress (Σ V B̄ᵀσ). Without it the stress works on volume changes it never
+  // saw: where plastic dilation (ψ > 0) makes the pressures within a cell differ, that spurious
+  // power grows until particles are thrown out of the surface beside a footing.
+  const bool shift_pressure = cell_average_;
+  if (shift_pressure) {
+    const auto mean_stress = [&](std::size_t p) { return (sigma[6 * p] + sigma[6 * p + 1] + sigma[6 * p + 2]) / 3.0; };
+    average_over_cells(mean_stress);
+    pressure_shift_.resize(kernel_->particle_count());
+    parallel_for(pressure_shift_.size(),
+                 [&](std::size_t p) { pressure_shift_[p] = cell_mean_[cell_of_[p]] - mean_stress(p); });
+  }
+  const double* shift = pressure_shift_.data();
   // One loop per combination of the liquid's reaction and the pore pressure, so that neither is
   // tested per node.
   auto scatter_forces = [&](auto support, auto with_liquid, auto with_pressure) {
@@ -694,6 +724,8 @@ void MechanicalPhysics<Dim>::predict() {
       // Total stress σ′ − p I, tension positive.
       double total[6];
       for (int i = 0; i < 6; ++i) total[i] = sigma[6 * p + i];
+      if (shift_pressure)
+        for (int i = 0; i < 3; ++i) total[i] += shift[p];
       if constexpr (pressure) {
         const double p_l = transfer.value_at(p, pl);
         for (int i = 0; i < 3; ++i) total[i] -= p_l;

@@ -136,7 +136,8 @@ class MechanicalPhysics final : public Physics {
   // ---- cell-averaged volumetric strain (only with cell_average_)
   std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step
   std::vector<std::size_t> cell_of_;              ///< per particle: its grid cell
-  std::vector<double> cell_volume_, cell_strain_; ///< per cell: Σ V, Σ V tr Δε_kinematic
+  std::vector<double> cell_volume_, cell_mean_;   ///< per cell: Σ V and the volume-weighted mean (average_over_cells)
+  std::vector<double> pressure_shift_;            ///< per particle: its cell's mean stress − its own (predict())
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
   std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP
@@ -183,6 +184,8 @@ class MechanicalPhysics final : public Physics {
   void map_to_particles();
   void set_geostatic_stress();
   void average_volumetric_strain();
+  template <class Value>
+  void average_over_cells(Value value);
   [[noreturn]] void report_failure(std::size_t p) const;
 };
 

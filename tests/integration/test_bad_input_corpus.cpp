@@ -20,7 +20,8 @@ const std::map<std::string, std::string> kScenes = {
     {"KA", "configs/verification/kurylyk_advection.yaml"}, {"P1", "configs/paper/frozen_inclusion_case1.yaml"},
     {"SW", "configs/verification/self_weight_column.yaml"}, {"VB", "configs/verification/vibrating_bar.yaml"},
     {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"},
-    {"RF", "configs/paper/rock_freezing.yaml"},          {"PF", "configs/verification/prandtl_footing.yaml"}};
+    {"RF", "configs/paper/rock_freezing.yaml"},          {"PF", "configs/verification/prandtl_footing.yaml"},
+    {"RS", "configs/verification/reissner_footing.yaml"}};
 
 struct Case {
   int line = 0;
