@@ -587,7 +587,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     out.failed = {failed_.data() + r.begin, count};
     out.p_wave_modulus = {wave_modulus_.data() + r.begin, count};
     out.shear_modulus = shear_.mutable_values().subspan(r.begin, count);
-    constexpr std::size_t kChunk = 4096;
+    constexpr std::size_t kChunk = 512;  // small enough that a 4k-particle scene fills two threads
     const std::size_t chunks = (count + kChunk - 1) / kChunk;
     std::vector<std::exception_ptr> errors(chunks);  // a model that throws: the first chunk's, rethrown here
 #pragma omp parallel for schedule(static) if (chunks > 1)
