@@ -260,17 +260,12 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
                                         shear_.write()};
   for (auto& h : variables_start_) start_reads.push_back(h.read());
   for (auto& h : variables_) start_writes.push_back(h.write());
-  std::vector<FieldRef> predict_reads = {node_velocity_.read(),         stress_.read(),
-                                         half_size_.read(),             node_pressure_.optional_read(),
-                                         liquid_drag_.optional_read(),  liquid_reaction_.optional_read(),
-                                         volume_.read(),                porosity_.read(),
-                                         saturation_.optional_read()};
-  if (cell_average_) predict_reads.push_back(position_.read());  // the cells of the mean stress
   return {
       {"mechanical.map_to_grid", Phase::MapToGrid, start_reads, start_writes, [this] { map_to_grid(); }},
       {"mechanical.predict",
        Phase::PredictMomentum,
-       predict_reads,
+       {node_velocity_.read(), stress_.read(), half_size_.read(), node_pressure_.optional_read(), liquid_drag_.optional_read(),
+        liquid_reaction_.optional_read(), volume_.read(), porosity_.read(), saturation_.optional_read()},
        {node_predicted_.write(), node_mobility_.write(), node_group_.write()},
        [this] { predict(); }},
       {"mechanical.correct",
@@ -625,24 +620,15 @@ void MechanicalPhysics<Dim>::update_stress() {
     report_failure(std::size_t(first - failed_.begin()));
 }
 
-/// The volume-weighted mean of value(p) over the particles of each grid cell, into cell_mean_
-/// (cell_of_ and cell_volume_ follow the current positions). The sums run in particle order on
-/// one thread: the same whatever the thread count.
+/// The volume-weighted mean of value(p) over the particles of each grid cell, into cell_mean_,
+/// with the cells and their volumes of the step (cell_of_, cell_volume_: average_volumetric_strain).
+/// The sums run in particle order on one thread: the same whatever the thread count.
 template <int Dim>
 template <class Value>
 void MechanicalPhysics<Dim>::average_over_cells(Value value) {
-  const auto& grid = kernel_->grid();
-  const auto x = position_.values();
   const auto vol = volume_.values();
-  const std::size_t n = kernel_->particle_count();
-  cell_of_.resize(n);
-  parallel_for(n, [&](std::size_t p) { cell_of_[p] = grid.cell_of(x.data() + p * Dim); });
-  cell_volume_.assign(grid.cell_count(), 0.0);
-  cell_mean_.assign(grid.cell_count(), 0.0);
-  for (std::size_t p = 0; p < n; ++p) {
-    cell_volume_[cell_of_[p]] += vol[p];
-    cell_mean_[cell_of_[p]] += vol[p] * value(p);
-  }
+  cell_mean_.assign(cell_volume_.size(), 0.0);
+  for (std::size_t p = 0; p < cell_of_.size(); ++p) cell_mean_[cell_of_[p]] += vol[p] * value(p);
   for (std::size_t c = 0; c < cell_mean_.size(); ++c)
     if (cell_volume_[c] > 0) cell_mean_[c] /= cell_volume_[c];
 }
@@ -654,11 +640,21 @@ void MechanicalPhysics<Dim>::average_over_cells(Value value) {
 /// predict() closes the B-bar form with the cell's mean stress in the nodal forces.
 template <int Dim>
 void MechanicalPhysics<Dim>::average_volumetric_strain() {
+  // The particles' cells and the cells' volumes, for the step (predict() uses them too: nothing
+  // moves between the two).
+  const auto& grid = kernel_->grid();
+  const auto x = position_.values();
+  const auto vol = volume_.values();
+  const std::size_t n = kernel_->particle_count();
+  cell_of_.resize(n);
+  parallel_for(n, [&](std::size_t p) { cell_of_[p] = grid.cell_of(x.data() + p * Dim); });
+  cell_volume_.assign(grid.cell_count(), 0.0);
+  for (std::size_t p = 0; p < n; ++p) cell_volume_[cell_of_[p]] += vol[p];
   average_over_cells([&](std::size_t p) {
     const double* de = strain_increment_.data() + 6 * p;
     return de[0] + de[1] + de[2] + 3.0 * thermal_strain_[p];
   });
-  parallel_for(kernel_->particle_count(), [&](std::size_t p) {
+  parallel_for(n, [&](std::size_t p) {
     double* de = strain_increment_.data() + 6 * p;
     const double mean = cell_mean_[cell_of_[p]] - 3.0 * thermal_strain_[p];
     const double shift = (mean - (de[0] + de[1] + de[2])) / 3.0;
@@ -683,7 +679,7 @@ void MechanicalPhysics<Dim>::predict() {
   const auto& transfer = kernel_->transfer();
   const auto& st = transfer.stencil();
   const auto vol = volume_.values();
-  const auto sigma = stress_.values();
+  auto sigma = stress_.values();
   const bool two_phase = liquid_drag_.bound();
   // The pore pressure of the step's start, as the liquid sees it: the nodal field.
   const auto pl = node_pressure_.bound() ? node_pressure_.values() : std::span<const double>{};
@@ -702,15 +698,16 @@ void MechanicalPhysics<Dim>::predict() {
   // the cell's mean stress (Σ V B̄ᵀσ). Without it the stress works on volume changes it never
   // saw: where plastic dilation (ψ > 0) makes the pressures within a cell differ, that spurious
   // power grows until particles are thrown out of the surface beside a footing.
-  const bool shift_pressure = cell_average_;
-  if (shift_pressure) {
+  if (cell_average_) {
     const auto mean_stress = [&](std::size_t p) { return (sigma[6 * p] + sigma[6 * p + 1] + sigma[6 * p + 2]) / 3.0; };
     average_over_cells(mean_stress);
-    pressure_shift_.resize(kernel_->particle_count());
-    parallel_for(pressure_shift_.size(),
-                 [&](std::size_t p) { pressure_shift_[p] = cell_mean_[cell_of_[p]] - mean_stress(p); });
+    force_stress_.assign(sigma.begin(), sigma.end());
+    parallel_for(cell_of_.size(), [&](std::size_t p) {
+      const double shift = cell_mean_[cell_of_[p]] - mean_stress(p);
+      for (int i = 0; i < 3; ++i) force_stress_[6 * p + i] += shift;
+    });
+    sigma = force_stress_;
   }
-  const double* shift = pressure_shift_.data();
   // One loop per combination of the liquid's reaction and the pore pressure, so that neither is
   // tested per node.
   auto scatter_forces = [&](auto support, auto with_liquid, auto with_pressure) {
@@ -724,8 +721,6 @@ void MechanicalPhysics<Dim>::predict() {
       // Total stress σ′ − p I, tension positive.
       double total[6];
       for (int i = 0; i < 6; ++i) total[i] = sigma[6 * p + i];
-      if (shift_pressure)
-        for (int i = 0; i < 3; ++i) total[i] += shift[p];
       if constexpr (pressure) {
         const double p_l = transfer.value_at(p, pl);
         for (int i = 0; i < 3; ++i) total[i] -= p_l;

@@ -137,7 +137,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step
   std::vector<std::size_t> cell_of_;              ///< per particle: its grid cell
   std::vector<double> cell_volume_, cell_mean_;   ///< per cell: Σ V and the volume-weighted mean (average_over_cells)
-  std::vector<double> pressure_shift_;            ///< per particle: its cell's mean stress − its own (predict())
+  std::vector<double> force_stress_;              ///< per particle: σ′ with its cell's mean trace, for the forces (predict())
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
   std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP

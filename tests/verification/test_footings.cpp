@@ -162,3 +162,21 @@ TEST_CASE("Prandtl-Reissner strip footing on weightless c-phi soil with a surcha
   CHECK(std::abs(fine) < 0.07);
   CHECK(std::log2(std::abs(coarse) / std::abs(fine)) > 0.5);
 }
+
+TEST_CASE("the cell-averaged volumetric strain and stress give the same footing bit for bit on 1 and 2 threads",
+          "[verification][mechanics][footing][threads]") {
+  // Past the peak (d ≈ 5 mm at t = 0.2 s): most of the soil under the footing yields and dilates.
+  TempDir dir;
+  std::string metrics[2];
+  for (int threads : {1, 2}) {
+    const std::string out = dir.file("threads" + std::to_string(threads));
+    const auto r = run_frostmpm("run " + verification_scene("reissner_footing.yaml") + " -o " + out +
+                                " --threads " + std::to_string(threads) +
+                                " --set time.end=0.2 --set output.progress=false --set output.metrics_every=0.01");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    metrics[threads - 1] = read_file(out + "/metrics.csv");
+  }
+  CHECK(metrics[0].find("footing_pressure") != std::string::npos);
+  CHECK(metrics[0] == metrics[1]);
+}
