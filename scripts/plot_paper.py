@@ -8,6 +8,7 @@
     /usr/bin/python3 scripts/plot_paper.py mn OUT_R0.5 OUT_R1.5 [more pairs at other cell sizes] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py rock OUT [OUT_beta0 OUT_beta4.5e-5] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py stabilization OUT_tau0 OUT_tau0.1 OUT_tau0.5 OUT_tau1 [--png FILE] [--frame N]
+    /usr/bin/python3 scripts/plot_paper.py footing_thermal OUT_0.2 OUT_0.1 [OUT_0.05] [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
@@ -23,7 +24,10 @@ against Morgenstern & Nixon's closed form. rock: the rock freezing of Sec. 5.2.2
 line per run (Fig. 17; the β_s variants by --set), contours of T, S_c, the radial displacement
 and p_l at 5, 10 and 15 h (Figs. 15–16, into FILE with _contours), and p_l, S_l and k along the
 x axis (Fig. 18, _profiles). stabilization: the pore pressure of runs with τ = 0, 0.1, 0.5, 1
-(App. C) at one frame (the last unless --frame). Each OUT is a run folder (metrics.csv, fields.h5).
+(App. C) at one frame (the last unless --frame). footing_thermal: the thermal mesh study of the
+strip footing on thawing ground (Sec. 5.3.2, configs/paper/strip_footing_thermal.yaml): the last
+frame's temperature with the −1, 0 and 1 °C lines per mesh (Fig. 24A–C), the temperature at A and B
+and the thaw depths against time, one line per mesh (Fig. 24E–F). Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -314,10 +318,41 @@ def stabilization(folders, png, frame):
     frostplot.save(fig, png)
 
 
+# ---- strip footing on thawing ground, thermal preliminary (Sec. 5.3.2) -------------------------
+
+def footing_thermal(folders, png):
+    frames = [frostplot.read_fields.read_frames(f)[-1] for f in folders]
+    fig, axes = plt.subplots(2, max(len(folders), 2), figsize=(5 * max(len(folders), 2), 8.5))
+    for ax, fr, folder in zip(axes[0], frames, folders):
+        frostplot.field_panel(ax, fig, fr, "temperature", levels=np.linspace(-5, 15, 21), label="T [°C]")
+        x, y = fr["coordinates"][:, 0], fr["coordinates"][:, 1]
+        ax.tricontour(x, y, fr["fields"]["temperature"], levels=[-1, 0, 1], colors=["b", "k", "r"], linewidths=1)
+        ax.set(title=f"{os.path.basename(folder.rstrip('/'))}: t = {fr['time'] / 86400 / 30.4375:.0f} months")
+    a, b = axes[1][0], axes[1][1]
+    for folder in folders:
+        m = metrics(folder)
+        months = m["time_s"] / 86400 / 30.4375
+        name = os.path.basename(folder.rstrip("/"))
+        line, = a.plot(months, m["T_A"], label=f"{name}: A (0, 3 m)")
+        a.plot(months, m["T_B"], color=line.get_color(), ls="--", label=f"{name}: B (0, 1.6 m)")
+        line, = b.plot(months, m["thaw_depth_centre"], label=f"{name}: centre line")
+        b.plot(months, m["thaw_depth_x6"], color=line.get_color(), ls="--", label=f"{name}: x = 6 m")
+    a.axhline(0, color="k", lw=0.5)
+    a.set(xlabel="t [months]", ylabel="T [°C]", title="temperature at A and B (Fig. 24E)")
+    b.set(xlabel="t [months]", ylabel="thaw depth [m]", title="thaw depth (S_l = 1/2; Fig. 24F)")
+    b.invert_yaxis()
+    a.legend(fontsize=7)
+    b.legend(fontsize=7)
+    for ax in axes[1][2:]:
+        ax.axis("off")
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization"])
+    parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
+                                                      "footing_thermal"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -335,6 +370,8 @@ def main():
         rock(args.folders, png)
     elif args.figure == "stabilization":
         stabilization(args.folders, png, args.frame)
+    elif args.figure == "footing_thermal":
+        footing_thermal(args.folders, png)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

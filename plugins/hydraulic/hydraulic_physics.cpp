@@ -63,6 +63,9 @@ ParamSchema HydraulicPhysics::material_schema() const {
 
 void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   kernel_ = &sim;
+  // The pressure solve's lattice graph, cell pressures and upwinding do not wrap round yet.
+  if (sim.grid().any_periodic())
+    throw params_.section_error("the hydraulic physics does not run on a periodic grid (grid.periodic) yet");
   // The body force on the pore water is the scene's gravity; [0, 0] makes pressure the excess
   // (non-hydrostatic) pressure, as in the INTERFROST cases.
   gravity_ = sim.gravity();

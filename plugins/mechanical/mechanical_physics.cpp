@@ -133,7 +133,8 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
       .defaults_to("jaumann");
   s.choice("initial_stress", {"none", "geostatic"},
            "geostatic: σ′_v from the weight of the material above each particle (minus the pore pressure), "
-           "σ′_h = σ′_zz = K0 σ′_v with the material's k0; gravity must point along −y")
+           "σ′_h = σ′_zz = K0 σ′_v with the material's k0, and with gravity tilted along the layer the shear "
+           "that balances it (an infinite slope); gravity must point down (−y)")
       .defaults_to("none");
   return s;
 }
@@ -232,9 +233,9 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   }
   if (geostatic_) {
     const auto g = kernel.gravity();
-    for (int d = 0; d + 1 < Dim; ++d)
-      if (g[d] != 0 || !(g[Dim - 1] < 0))
-        throw params_.error("initial_stress", "a geostatic initial stress needs gravity along −y (gravity: [0, -9.81])");
+    if (!(g[Dim - 1] < 0))
+      throw params_.error("initial_stress",
+                          "a geostatic initial stress needs gravity with a downward (−y) component, e.g. [0, -9.81]");
   }
   read_boundaries(kernel);
 
@@ -351,13 +352,16 @@ void MechanicalPhysics<Dim>::initialize() {
 
 /// σ′_v(p) = −|g| (Σ over the particles above p in its column of ρ_m Δz + ½ ρ_m Δz of p) + p_l,
 /// σ′_h = σ′_zz = K0 σ′_v: the weight of the material above, with the pore pressure taken off
-/// (σ = σ′ − p_l I). Δz is a particle's height, twice its GIMP half-width.
+/// (σ = σ′ − p_l I). Δz is a particle's height, twice its GIMP half-width. Gravity with a
+/// component g_x along the layer (an infinite slope in its own frame, gravity tilted by the slope
+/// angle) adds the shear that balances it, σ_xy = g_x (Σ ρ_m Δz + ½ ρ_m Δz of p).
 template <int Dim>
 void MechanicalPhysics<Dim>::set_geostatic_stress() {
   const auto x = position_.values();
   const auto half = half_size_.values();
   const std::size_t n = kernel_->particle_count();
-  const double g = -kernel_->gravity()[Dim - 1];
+  const auto gravity = kernel_->gravity();
+  const double g = -gravity[Dim - 1];
   const auto& grid = kernel_->grid();
   // Columns: particles with the same horizontal coordinates (the lattice they were made on).
   std::map<std::vector<long>, std::vector<std::size_t>> columns;
@@ -376,13 +380,15 @@ void MechanicalPhysics<Dim>::set_geostatic_stress() {
       double rho_m, skeleton, n_l;
       densities(p, rho_m, skeleton, n_l);
       const double dz = 2.0 * half[p * Dim + Dim - 1];
-      const double vertical = -g * (above + 0.5 * rho_m * dz) + (pl.empty() ? 0.0 : pl[p]);
+      const double column = above + 0.5 * rho_m * dz;  // mass per horizontal area above p's centre
+      const double vertical = -g * column + (pl.empty() ? 0.0 : pl[p]);
       above += rho_m * dz;
       const double k0 = materials_[kernel_->transfer().material(p)].k0;
       double* s = sigma.data() + 6 * p;
       std::fill(s, s + 6, 0.0);
       for (int d = 0; d < 3; ++d) s[d] = k0 * vertical;
       s[Dim - 1] = vertical;
+      for (int d = 0; d + 1 < Dim; ++d) s[tensor3::kVoigt[d][Dim - 1]] = gravity[d] * column;
     }
   }
 }

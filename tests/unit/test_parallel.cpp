@@ -22,17 +22,19 @@ struct Scatter {
   ColouredBlocks<2> blocks;
   std::vector<double> values;
 
-  explicit Scatter(ShapeKind kind) {
+  /// periodic: the grid wraps along x and the particles fill it across the seam.
+  explicit Scatter(ShapeKind kind, bool periodic = false) {
     grid.spacing = {0.1, 0.1};
     grid.cells = {37, 23};
     grid.ghost_layers = ghost_layers(kind);
+    grid.periodic = {periodic, false};
     stencil.configure(kind);
     std::vector<double> pos, half;
     // 3×3 particles per cell, jittered, so sums are not trivially exact; a cell's margin
-    // keeps every GIMP support inside the grid.
-    for (int i = 3; i < 36 * 3; ++i)
+    // keeps every GIMP support inside the grid (but for x on a periodic grid).
+    for (int i = periodic ? 0 : 3; i < (periodic ? 37 : 36) * 3; ++i)
       for (int j = 3; j < 22 * 3; ++j) {
-        pos.push_back((i + 0.5 + 0.3 * std::sin(7.0 * i + j)) * 0.1 / 3);
+        pos.push_back(grid.wrap_position(0, (i + 0.5 + 0.3 * std::sin(7.0 * i + j)) * 0.1 / 3));
         pos.push_back((j + 0.5 + 0.3 * std::cos(3.0 * i - j)) * 0.1 / 3);
         half.insert(half.end(), {0.1 / 6, 0.1 / 6});
         values.push_back(std::sin(0.37 * i) * std::exp(0.01 * j) + 1e-7 * i * j);
@@ -57,13 +59,14 @@ struct Scatter {
 }  // namespace
 
 TEST_CASE("coloured blocks: same-colour blocks share no node, every particle once", "[parallel]") {
+  for (const bool periodic : {false, true})
   for (ShapeKind kind : {ShapeKind::Linear, ShapeKind::Gimp, ShapeKind::CubicBSpline}) {
-    INFO(to_string(kind));
-    Scatter s(kind);
+    INFO(to_string(kind) << (periodic ? ", periodic along x" : ""));
+    Scatter s(kind, periodic);
     REQUIRE(s.blocks.particles() == s.values.size());
     std::vector<int> visits(s.values.size(), 0);
     const int K = s.stencil.per_particle();
-    for (int c = 0; c < ColouredBlocks<2>::kColours; ++c) {
+    for (int c = 0; c < ColouredBlocks<2>::kGroups; ++c) {
       std::vector<long> writer(s.grid.node_count(), -1);  // block that wrote each node in colour c
       for (std::uint32_t b = s.blocks.first_block(c); b < s.blocks.first_block(c + 1); ++b)
         for (std::uint32_t p : s.blocks.block(b)) {
@@ -76,14 +79,18 @@ TEST_CASE("coloured blocks: same-colour blocks share no node, every particle onc
         }
     }
     for (int v : visits) REQUIRE(v == 1);
+    // The stencils across the seam: one serial block, only on a periodic grid.
+    const auto seam = s.blocks.first_block(ColouredBlocks<2>::kGroups) - s.blocks.first_block(ColouredBlocks<2>::kColours);
+    REQUIRE(seam == (periodic ? 1u : 0u));
     REQUIRE(s.blocks.blocks() > 8);  // enough blocks per colour to keep threads busy
   }
 }
 
 TEST_CASE("coloured P2G scatter is bitwise identical on 1, 2 and 4 threads", "[parallel]") {
+  for (const bool periodic : {false, true})
   for (ShapeKind kind : {ShapeKind::Linear, ShapeKind::Gimp, ShapeKind::CubicBSpline}) {
-    INFO(to_string(kind));
-    Scatter s(kind);
+    INFO(to_string(kind) << (periodic ? ", periodic along x" : ""));
+    Scatter s(kind, periodic);
     const auto one = s.p2g(1);
     for (int threads : {2, 4}) {
       const auto many = s.p2g(threads);

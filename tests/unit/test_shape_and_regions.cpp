@@ -148,3 +148,60 @@ TEST_CASE("regions: a bad shape names the YAML path and the valid shapes", "[reg
     REQUIRE(std::string(e.what()).find("box, disk, half_disk, polygon") != std::string::npos);
   }
 }
+
+TEST_CASE("a periodic axis wraps the stencil: the weights of a particle next to the seam are those of its "
+          "image one period inside, on nodes one period round",
+          "[shape][periodic]") {
+  for (ShapeKind kind : {ShapeKind::Linear, ShapeKind::Gimp, ShapeKind::CubicBSpline}) {
+    INFO(to_string(kind));
+    auto grid = make_grid(kind);
+    grid.periodic = {true, false};
+    const double period = grid.cells[0] * grid.spacing[0];
+    // Near x = 0 and x = L, every part of the support reaches past the seam; at mid-height.
+    for (const double x : {0.0, 0.004, 0.03, 0.05, 0.97, 0.999, 0.9999999}) {
+      INFO("x = " << x);
+      StencilCache<2> wrapped, inner;
+      wrapped.configure(kind);
+      inner.configure(kind);
+      // The image: the same particle on a wide, non-periodic grid, half a period further in.
+      auto wide = make_grid(kind);
+      wide.cells[0] = 3 * grid.cells[0];
+      const std::vector<double> half = {0.025, 0.05};
+      const std::vector<double> pos = {x, 0.5}, image = {x + period, 0.5};
+      REQUIRE(wrapped.update(grid, pos, half) == -1);
+      REQUIRE(inner.update(wide, image, half) == -1);
+      double sum = 0;
+      for (int k = 0; k < wrapped.per_particle(); ++k) {
+        const auto ijk = grid.node_lattice(wrapped.nodes(0)[k]);
+        const auto far = wide.node_lattice(inner.nodes(0)[k]);
+        REQUIRE(ijk[0] >= 0);
+        REQUIRE(ijk[0] < grid.cells[0]);  // node `cells` is node 0
+        REQUIRE(ijk[0] == (far[0] - grid.cells[0] + 2 * grid.cells[0]) % grid.cells[0]);
+        REQUIRE(ijk[1] == far[1]);
+        REQUIRE(wrapped.weights(0)[k] == Approx(inner.weights(0)[k]).margin(1e-12));
+        REQUIRE(wrapped.gradients(0)[2 * k] == Approx(inner.gradients(0)[2 * k]).margin(1e-9));
+        sum += wrapped.weights(0)[k];
+      }
+      REQUIRE(sum == Approx(1.0).margin(1e-12));
+    }
+    // Positions wrap into [origin, origin + L), also from just below the origin.
+    REQUIRE(grid.wrap_position(0, -1e-17) < period);
+    REQUIRE(grid.wrap_position(0, -0.25) == Approx(period - 0.25));
+    REQUIRE(grid.wrap_position(0, 2 * period + 0.3) == Approx(0.3));
+    REQUIRE(grid.wrap_position(1, -0.25) == -0.25);  // y is not periodic
+  }
+}
+
+TEST_CASE("faces of a periodic grid: the face across the periodic axis has one node per cell, each a whole cell",
+          "[shape][periodic]") {
+  auto grid = make_grid(ShapeKind::Gimp);
+  grid.periodic = {true, false};
+  std::vector<std::size_t> nodes;
+  std::vector<double> areas;
+  face_nodes(grid, GridFace{1, -1}, nodes, areas);
+  REQUIRE(nodes.size() == std::size_t(grid.cells[0]));
+  double length = 0;
+  for (double a : areas) length += a;
+  REQUIRE(length == Approx(grid.cells[0] * grid.spacing[0]));
+  REQUIRE(box_nodes<2>(grid, {0.0, 0.0}, {1.0, 0.0}).size() == std::size_t(grid.cells[0]));
+}

@@ -14,10 +14,11 @@ ColumnRun run_column(const ColumnSetup& s) {
   ConfigNode file = ConfigNode::load_file(source_dir() + "/configs/verification/" + s.scene);
   YAML::Node tree = file.raw();
   const long cells = std::lround(s.length / s.cell);
+  const std::string along = std::to_string(cells), across = "1", l = std::to_string(s.length), w = std::to_string(s.cell);
   std::vector<std::string> overrides = {
-      "grid.cells=[1, " + std::to_string(cells) + "]",
+      "grid.cells=[" + (s.along_x ? along + ", " + across : across + ", " + along) + "]",
       "grid.cell_size=" + std::to_string(s.cell),
-      "regions.0.shape={box: {min: [0, 0], max: [" + std::to_string(s.cell) + ", " + std::to_string(s.length) + "]}}",
+      "regions.0.shape={box: {min: [0, 0], max: [" + (s.along_x ? l + ", " + w : w + ", " + l) + "]}}",
       "physics.thermal.scheme=" + s.scheme,
       "output.progress=false",
   };
@@ -42,7 +43,7 @@ ColumnRun run_column(const ColumnSetup& s) {
   const auto T = sim.particles().field("temperature");
   const auto Tp = sim.particles().field("temperature_pic");
   for (std::size_t p = 0; p < sim.particles().size(); ++p) {
-    run.depth.push_back(s.length - pos[p * kDim + 1]);
+    run.depth.push_back(s.along_x ? pos[p * kDim] : s.length - pos[p * kDim + 1]);
     run.temperature.push_back(T[p]);
     run.temperature_pic.push_back(Tp[p]);
   }

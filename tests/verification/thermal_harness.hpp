@@ -14,7 +14,7 @@
 namespace frostmpm::test {
 
 struct ColumnRun {
-  std::vector<double> depth;        ///< distance below the surface of every particle [m]
+  std::vector<double> depth;        ///< distance below the surface of every particle [m] (along_x: x)
   std::vector<double> temperature;  ///< FLIP (state) temperature
   std::vector<double> temperature_pic;
   std::vector<std::string> metrics_header;
@@ -34,6 +34,7 @@ struct ColumnSetup {
   std::string scheme = "explicit";
   double dt = 0;            ///< implicit step [s]
   std::vector<std::string> overrides;
+  bool along_x = false;     ///< a bar along x from x = 0 (one cell tall) instead of a column
 };
 
 ColumnRun run_column(const ColumnSetup& setup);

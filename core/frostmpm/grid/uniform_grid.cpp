@@ -30,7 +30,8 @@ void face_nodes(const UniformGrid<Dim>& grid, GridFace face, std::vector<std::si
   // Iterate the domain lattice of the face: fixed coordinate on `axis`, all others free.
   std::array<int, Dim> ijk{};
   std::array<int, Dim> count{};
-  for (int d = 0; d < Dim; ++d) count[d] = grid.cells[d] + 1;
+  // Along a periodic axis node `cells` is node 0: the face has `cells` nodes, each a full cell.
+  for (int d = 0; d < Dim; ++d) count[d] = grid.cells[d] + (grid.periodic[d] ? 0 : 1);
   count[face.axis] = 1;
   std::size_t total = 1;
   for (int d = 0; d < Dim; ++d) total *= static_cast<std::size_t>(count[d]);
@@ -42,7 +43,7 @@ void face_nodes(const UniformGrid<Dim>& grid, GridFace face, std::vector<std::si
       rest /= static_cast<std::size_t>(count[d]);
       if (d == face.axis) continue;
       // Tributary length: half a cell at the ends of the face, a full cell inside.
-      const bool end = ijk[d] == 0 || ijk[d] == grid.cells[d];
+      const bool end = !grid.periodic[d] && (ijk[d] == 0 || ijk[d] == grid.cells[d]);
       area *= end ? 0.5 * grid.spacing[d] : grid.spacing[d];
     }
     ijk[face.axis] = face.side < 0 ? 0 : grid.cells[face.axis];
@@ -59,7 +60,7 @@ std::vector<std::size_t> box_nodes(const UniformGrid<Dim>& grid, const std::arra
   for (int d = 0; d < Dim; ++d) {
     const double tol = 1e-9 * grid.spacing[d];
     first[d] = std::max(0, static_cast<int>(std::ceil((lo[d] - tol - grid.origin[d]) / grid.spacing[d])));
-    last[d] = std::min(grid.cells[d], static_cast<int>(std::floor((hi[d] + tol - grid.origin[d]) / grid.spacing[d])));
+    last[d] = std::min(grid.cells[d] - (grid.periodic[d] ? 1 : 0), static_cast<int>(std::floor((hi[d] + tol - grid.origin[d]) / grid.spacing[d])));
     if (last[d] < first[d]) return out;
   }
   std::array<int, Dim> ijk = first;

@@ -1,7 +1,9 @@
 #pragma once
 // Uniform Cartesian background grid in Dim dimensions. Node (i, j[, k]) sits at
 // origin + (i, j[, k]) * spacing; `ghost_layers` extra node layers on every side serve
-// shape functions whose support reaches past the domain (cubic B-splines).
+// shape functions whose support reaches past the domain (cubic B-splines). A periodic axis
+// identifies its max face with its min face: lattice coordinates wrap into [0, cells), so the
+// nodes of lattice coordinate `cells` (and the ghost layers) along it are never used.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,6 +20,28 @@ struct UniformGrid {
   std::array<double, Dim> spacing{};
   std::array<int, Dim> cells{};
   int ghost_layers = 0;
+  std::array<bool, Dim> periodic{};
+
+  bool any_periodic() const {
+    for (int d = 0; d < Dim; ++d)
+      if (periodic[d]) return true;
+    return false;
+  }
+  /// Lattice coordinate i along axis d, brought into [0, cells) when the axis is periodic.
+  int wrap(int d, int i) const {
+    if (!periodic[d]) return i;
+    const int n = cells[d];
+    return ((i % n) + n) % n;
+  }
+  /// Position x along axis d, brought into [origin, origin + length) when the axis is periodic.
+  double wrap_position(int d, double x) const {
+    if (!periodic[d]) return x;
+    const double length = cells[d] * spacing[d];
+    double shifted = std::fmod(x - origin[d], length);
+    if (shifted < 0) shifted += length;
+    if (shifted >= length) shifted = 0;  // -1e-17 + length rounds to length
+    return origin[d] + shifted;
+  }
 
   int nodes_along(int d) const { return cells[d] + 1 + 2 * ghost_layers; }
   std::size_t node_count() const {

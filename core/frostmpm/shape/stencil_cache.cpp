@@ -41,7 +41,8 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
       // GIMP integrates over the particle domain inside the grid, Ω_p ∩ Ω (paper Eq. 58): a domain
       // that reaches past the grid's edge (a particle pressed against a fixed boundary) is clipped
       // to it, which keeps the partition of unity. A domain wholly outside has left the grid.
-      if constexpr (Kind == ShapeKind::Gimp) {
+      // A periodic axis has no edge: the support wraps (below) and is never clipped.
+      if (Kind == ShapeKind::Gimp && !grid.periodic[d]) {
         // Beyond round-off (shape_1d's own tolerance): a domain that ends on the edge, as every
         // lattice particle's does, keeps its weights.
         const double edge_lo = -grid.ghost_layers, edge_hi = grid.cells[d] + grid.ghost_layers;
@@ -61,7 +62,7 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
       // the domain edge); it is then pointed at a valid node. A domain that ends past the edge
       // by less than the round-off above was not clipped and may hold a ~1e-26 weight there
       // (a moving particle pressed against a fixed face): that is round-off, dropped.
-      for (int k = 0; k < width; ++k) {
+      for (int k = 0; k < width && !grid.periodic[d]; ++k) {
         const int node = base[d] + k;
         if (node >= -grid.ghost_layers && node <= grid.cells[d] + grid.ghost_layers) continue;
         if (Kind == ShapeKind::Gimp && std::abs(node - xi) >= 1.0 + half - 2.0 * tolerance(xi)) {
@@ -87,7 +88,9 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
     double* gradient_p = gradient_out + p * K * Dim;
     bool on_grid = true;
     for (int d = 0; d < Dim; ++d)
-      on_grid = on_grid && base[d] >= -grid.ghost_layers && base[d] + width - 1 <= grid.cells[d] + grid.ghost_layers;
+      on_grid = on_grid && (grid.periodic[d] ? base[d] >= 0 && base[d] + width <= grid.cells[d]
+                                             : base[d] >= -grid.ghost_layers &&
+                                                   base[d] + width - 1 <= grid.cells[d] + grid.ghost_layers);
     const std::size_t first = on_grid ? grid.node_index(base) : 0;
     std::array<std::size_t, Dim> stride{};
     for (int d = 0, s = 1; d < Dim; s *= grid.nodes_along(d), ++d) stride[d] = static_cast<std::size_t>(s);
@@ -101,6 +104,8 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
         rest /= width;
         if (on_grid)
           index += static_cast<std::size_t>(offset[d]) * stride[d];
+        else if (grid.periodic[d])
+          ijk[d] = grid.wrap(d, base[d] + offset[d]);
         else
           ijk[d] = std::clamp(base[d] + offset[d], -grid.ghost_layers, grid.cells[d] + grid.ghost_layers);
       }

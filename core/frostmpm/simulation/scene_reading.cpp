@@ -113,6 +113,12 @@ void Simulation::read_grid(const ConfigNode& node) {
            "a particle whose support leaves the grid: stop the run naming it, or remove it (what it carries is "
            "counted in run.json)")
       .defaults_to("stop");
+  std::vector<std::string> periodic_choices = {"none", "x", "y"};
+  if (kDim == 3) periodic_choices.insert(periodic_choices.end(), {"z", "xz"});
+  s.choice("periodic", periodic_choices,
+           "axes along which the grid wraps round (max face = min face), e.g. x for an infinite slope or "
+           "layer; conditions on those faces are refused")
+      .defaults_to("none");
   const ParamSet p = parse_params(s, node);
   const auto& cells = p.reals("cells");
   const auto& h = p.reals("cell_size");
@@ -136,6 +142,16 @@ void Simulation::read_grid(const ConfigNode& node) {
   shape_ = parse_shape_kind(p.string("shape_function"));
   leaving_ = p.string("particles_leaving") == "remove" ? LeavingPolicy::Remove : LeavingPolicy::Stop;
   grid_.ghost_layers = ghost_layers(shape_);
+  const std::string& periodic = p.string("periodic");
+  for (int d = 0; d < kDim; ++d) {
+    grid_.periodic[d] = periodic.find("xyz"[d]) != std::string::npos && periodic != "none";
+    // More cells than the support is wide: a wrapped stencil never meets itself.
+    const int needed = support_width(shape_) + 1;
+    if (grid_.periodic[d] && grid_.cells[d] < needed)
+      throw p.error("periodic", std::string("a periodic axis needs at least ") + std::to_string(needed) +
+                                    " cells with the " + to_string(shape_) + " shape function; axis " + "xyz"[d] +
+                                    " has " + std::to_string(grid_.cells[d]));
+  }
   transfer_.configure(shape_);
   resolved_["grid"] = p.to_yaml();
 }
@@ -371,6 +387,9 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
         bool ok = false;
         const GridFace f = GridFace::parse(face->as_string(), kDim, ok);
         if (!ok) throw face->error("'" + face->as_string() + "' is not a face; valid: x_min, x_max, y_min, y_max");
+        if (grid_.periodic[f.axis])
+          throw face->error("face " + f.name() + " is not a boundary: the grid is periodic along " + "xyz"[f.axis] +
+                            " (grid.periodic); use a face across another axis or a box");
         face_nodes(grid_, f, bc.nodes, bc.node_areas);
         bc.face_axis = f.axis;
         bc.face_side = f.side;

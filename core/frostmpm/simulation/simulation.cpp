@@ -430,6 +430,13 @@ void Simulation::apply_initial_values() {
 // ---- geometry and the step ------------------------------------------------------------------------
 
 void Simulation::update_stencil() {
+  if (grid_.any_periodic()) {
+    // A particle that crossed a periodic seam re-enters at the other side.
+    auto x = particles_.field("position");
+    parallel_for(particles_.size(), [&](std::size_t p) {
+      for (int d = 0; d < kDim; ++d) x[p * kDim + d] = grid_.wrap_position(d, x[p * kDim + d]);
+    });
+  }
   long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
   if (outside >= 0 && leaving_ == LeavingPolicy::Remove) {
     // The stencil of a particle outside the grid has every weight zero (inside: they sum to 1).

@@ -1,6 +1,7 @@
 #include "frostmpm/transfer/coloured_blocks.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -23,21 +24,37 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
   // writes lies within `width` columns of it along each axis). A stencil is a tensor product of
   // one run of nodes per axis and a node's index grows with each of its lattice coordinates, so
   // the lowest node along every axis is the stencil's lowest index.
+  // A stencil wrapped across a periodic seam spans (almost) the whole axis between its lowest
+  // and highest node; it goes to the serial block `block_count` (a periodic axis has more cells
+  // than the support is wide, so an unwrapped stencil never spans that far).
+  const std::size_t wrapped_block = block_count;
   std::vector<std::uint32_t> block_of(n);
   parallel_for(n, [&](std::size_t p) {
     const auto* nodes = stencil.nodes(p);
-    std::uint32_t lowest = nodes[0];
-    for (int k = 1; k < K; ++k) lowest = std::min(lowest, nodes[k]);
+    std::uint32_t lowest = nodes[0], highest = nodes[0];
+    for (int k = 1; k < K; ++k) {
+      lowest = std::min(lowest, nodes[k]);
+      highest = std::max(highest, nodes[k]);
+    }
     const auto low = grid.node_lattice(lowest);
+    if (grid.any_periodic()) {
+      const auto high = grid.node_lattice(highest);
+      for (int d = 0; d < Dim; ++d)
+        if (std::abs(high[d] - low[d]) >= width) {
+          block_of[p] = static_cast<std::uint32_t>(wrapped_block);
+          return;
+        }
+    }
     std::size_t index = 0;
     for (int d = Dim - 1; d >= 0; --d)
       index = index * static_cast<std::size_t>(blocks_along[d]) +
               static_cast<std::size_t>((low[d] + grid.ghost_layers) / width);
     block_of[p] = static_cast<std::uint32_t>(index);
   });
-  std::vector<std::uint32_t> count(block_count, 0);
+  std::vector<std::uint32_t> count(block_count + 1, 0);
   for (std::size_t p = 0; p < n; ++p) ++count[block_of[p]];
   auto colour_of = [&](std::size_t block) {
+    if (block == wrapped_block) return kColours;
     int colour = 0;
     for (int d = 0; d < Dim; ++d) {
       colour |= static_cast<int>(block % static_cast<std::size_t>(blocks_along[d]) % 2) << d;
@@ -47,11 +64,11 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
   };
   // Non-empty blocks, sorted by colour (then by block index, for a fixed order).
   std::vector<std::uint32_t> used;
-  for (std::size_t b = 0; b < block_count; ++b)
+  for (std::size_t b = 0; b <= block_count; ++b)
     if (count[b]) used.push_back(static_cast<std::uint32_t>(b));
   std::stable_sort(used.begin(), used.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return colour_of(a) < colour_of(b); });
-  std::vector<std::uint32_t> slot(block_count, 0);
+  std::vector<std::uint32_t> slot(block_count + 1, 0);
   block_begin_.assign(used.size() + 1, 0);
   colour_begin_.fill(0);
   for (std::size_t i = 0; i < used.size(); ++i) {
@@ -59,7 +76,7 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
     slot[used[i]] = block_begin_[i];
     colour_begin_[colour_of(used[i]) + 1] = static_cast<std::uint32_t>(i + 1);
   }
-  for (int c = 1; c <= kColours; ++c) colour_begin_[c] = std::max(colour_begin_[c], colour_begin_[c - 1]);
+  for (int c = 1; c <= kGroups; ++c) colour_begin_[c] = std::max(colour_begin_[c], colour_begin_[c - 1]);
   order_.resize(n);
   for (std::size_t p = 0; p < n; ++p) order_[slot[block_of[p]]++] = static_cast<std::uint32_t>(p);
   version_ = stencil.version();

@@ -10,6 +10,10 @@
 // order whatever the thread count, and P2G sums are bitwise reproducible on 1, 2 or 64
 // threads — the property the issue tracker asks of every result.
 //
+// On a periodic axis a stencil that wraps across the seam touches both ends of the lattice; such
+// particles (a column of them per periodic axis) form one more group, scattered serially after
+// the colours.
+//
 // Gather loops (G2P) need none of this: a plain `omp parallel for` over particles is exact.
 #include <array>
 #include <cstddef>
@@ -27,6 +31,8 @@ template <int Dim>
 class ColouredBlocks {
  public:
   static constexpr int kColours = 1 << Dim;
+  /// The colours, then the serial group of stencils that wrap across a periodic seam.
+  static constexpr int kGroups = kColours + 1;
 
   /// Groups the stencil's particles into coloured blocks. Call again whenever the stencil
   /// topology changes (StencilCache::topology_changed()).
@@ -37,16 +43,16 @@ class ColouredBlocks {
   template <class F>
   void for_each(F&& f) const {
     const bool parallel = order_.size() >= kParallelMinimum;  // see parallel.hpp
-    for (int c = 0; c < kColours; ++c) {
+    for (int c = 0; c < kGroups; ++c) {
       const std::uint32_t first = colour_begin_[c], last = colour_begin_[c + 1];
-#pragma omp parallel for schedule(dynamic, 4) if (parallel)
+#pragma omp parallel for schedule(dynamic, 4) if (parallel && c < kColours)
       for (std::uint32_t b = first; b < last; ++b)
         for (std::uint32_t k = block_begin_[b]; k < block_begin_[b + 1]; ++k) f(std::size_t{order_[k]});
     }
   }
 
   std::size_t particles() const { return order_.size(); }
-  /// Blocks of colour c are [first_block(c), first_block(c + 1)).
+  /// Blocks of colour (or group) c are [first_block(c), first_block(c + 1)).
   std::uint32_t first_block(int c) const { return colour_begin_[c]; }
   /// Particles of block b, in the order for_each visits them.
   std::span<const std::uint32_t> block(std::uint32_t b) const {
@@ -59,7 +65,7 @@ class ColouredBlocks {
  private:
   std::vector<std::uint32_t> order_;        ///< particle indices, block by block
   std::vector<std::uint32_t> block_begin_;  ///< blocks sorted by colour; block b = order_[begin[b], begin[b+1])
-  std::array<std::uint32_t, kColours + 1> colour_begin_{};  ///< blocks of colour c: [begin[c], begin[c+1])
+  std::array<std::uint32_t, kGroups + 1> colour_begin_{};  ///< blocks of colour c: [begin[c], begin[c+1])
   std::uint64_t version_ = 0;
 };
 
