@@ -22,11 +22,12 @@ inline std::string exact_number(double v) {
 /// configs/verification/<file> in the source tree (a paper scene as "../paper/<file>").
 inline std::string verification_scene(const std::string& file) { return source_dir() + "/configs/verification/" + file; }
 
-/// Runs the scene file `scene` into dir/name with `--set` overrides and no progress line;
-/// requires exit 0 and returns its metrics.csv.
+/// Runs the scene file `scene` into dir/name with `--set` overrides and no progress line (on
+/// `threads` threads when given); requires exit 0 and returns its metrics.csv.
 inline CsvTable run_scene(const TempDir& dir, const std::string& scene, const std::vector<std::string>& sets,
-                          const std::string& name) {
+                          const std::string& name, int threads = 0) {
   std::string cmd = "run " + scene + " -o " + dir.file(name) + " --set output.progress=false";
+  if (threads > 0) cmd += " --threads " + std::to_string(threads);
   for (const auto& s : sets) cmd += " --set '" + s + "'";
   const auto r = run_frostmpm(cmd);
   INFO(r.output);

@@ -169,13 +169,10 @@ TEST_CASE("the cell-averaged volumetric strain and stress give the same footing 
   TempDir dir;
   std::string metrics[2];
   for (int threads : {1, 2}) {
-    const std::string out = dir.file("threads" + std::to_string(threads));
-    const auto r = run_frostmpm("run " + verification_scene("reissner_footing.yaml") + " -o " + out +
-                                " --threads " + std::to_string(threads) +
-                                " --set time.end=0.2 --set output.progress=false --set output.metrics_every=0.01");
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
-    metrics[threads - 1] = read_file(out + "/metrics.csv");
+    const std::string name = "threads" + std::to_string(threads);
+    run_scene(dir, verification_scene("reissner_footing.yaml"), {"time.end=0.2", "output.metrics_every=0.01"}, name,
+              threads);
+    metrics[threads - 1] = read_file(dir.file(name + "/metrics.csv"));
   }
   CHECK(metrics[0].find("footing_pressure") != std::string::npos);
   CHECK(metrics[0] == metrics[1]);

@@ -144,7 +144,7 @@ void Simulation::read_grid(const ConfigNode& node) {
   grid_.ghost_layers = ghost_layers(shape_);
   const std::string& periodic = p.string("periodic");
   for (int d = 0; d < kDim; ++d) {
-    grid_.periodic[d] = periodic.find("xyz"[d]) != std::string::npos && periodic != "none";
+    grid_.periodic[d] = periodic.find("xyz"[d]) != std::string::npos;  // "none" names no axis
     // More cells than the support is wide: a wrapped stencil never meets itself.
     const int needed = support_width(shape_) + 1;
     if (grid_.periodic[d] && grid_.cells[d] < needed)
