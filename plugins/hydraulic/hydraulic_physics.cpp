@@ -70,6 +70,7 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   // (non-hydrostatic) pressure, as in the INTERFROST cases.
   gravity_ = sim.gravity();
   mass_scaling_ = sim.time_params().real("mass_scaling");
+  transport_scaling_ = sim.time_params().real("transport_scaling");
   sim.declare_state_field("porosity", 1, 0.0);
   sim.declare_state_field("pore_pressure", 1, 0.0, /*max_magnitude Pa=*/1e10);
   sim.declare_field("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
@@ -242,7 +243,7 @@ void HydraulicPhysics::update_coefficients() {
     const auto& m = materials_[material_[p]];
     const double rho = m.water_density;
     n_l_[p] = phi[p] * std::clamp(S[p], 0.0, 1.0);
-    const double conductivity = std::max(k_a_[p] * k_r_[p], 1e-300);
+    const double conductivity = std::max(transport_scaling_ * k_a_[p] * k_r_[p], 1e-300);
     drag_[p] = n_l_[p] * n_l_[p] * rho * reference_gravity_ / conductivity;
     const double inertia = mass_scaling_ * (n_l_[p] * rho);
     xi_[p] = inertia > 0 ? inertia / (inertia + dt_ * drag_[p]) : 0.0;

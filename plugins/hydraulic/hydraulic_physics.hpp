@@ -120,6 +120,7 @@ class HydraulicPhysics final : public Physics {
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
   double mass_scaling_ = 1;
+  double transport_scaling_ = 1;  ///< time.transport_scaling: the factor on every permeability
   bool phase_change_source_ = true;
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)

@@ -65,6 +65,7 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
 
 void ThermalPhysics::setup(Kernel<kDim>& sim) {
   kernel_ = &sim;
+  transport_scaling_ = sim.time_params().real("transport_scaling");
   sim.declare_state_field("temperature", 1, 0.0, /*max_magnitude degC=*/1e4);
   sim.declare_state_field("porosity", 1, 0.0);
   sim.declare_field("temperature_pic", 1);
@@ -223,7 +224,8 @@ double ThermalPhysics::value_at(const ParticleCondition& c, double t) const {
 void ThermalPhysics::evaluate_particle_properties(std::size_t p, double phi, double T_property) {
   const auto& table = *tables_[material_[p]];
   const int h = table.locate(T_property, hint_[p]);
-  conductivity_[p] = constants_[material_[p]].conductivity(phi, std::clamp(table.saturation(T_property, h), 0.0, 1.0));
+  conductivity_[p] = transport_scaling_ *
+                     constants_[material_[p]].conductivity(phi, std::clamp(table.saturation(T_property, h), 0.0, 1.0));
 }
 
 double ThermalPhysics::particle_heat(std::size_t p, std::span<const double> T, std::span<const double> phi,

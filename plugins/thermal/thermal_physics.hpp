@@ -117,6 +117,7 @@ class ThermalPhysics final : public Physics {
   // porosity and heat_deviation) ----------------------------------------------------------------
   std::span<const std::uint16_t> material_;  ///< material index of every particle (the kernel's)
   std::vector<double> conductivity_;     ///< κ_p at the property temperature
+  double transport_scaling_ = 1;         ///< time.transport_scaling: the factor on every conductivity
   std::vector<double> energy_;           ///< scratch: heat content, or deviation shed to the grid
   std::vector<int> hint_;                ///< enthalpy-table interval of every particle
 

@@ -121,3 +121,67 @@ TEST_CASE("bad initial tables and water tables are one line naming the key", "[i
   refused("regions.0.initial.pore_pressure={hydrostatic: {level: 1}}", "regions.0.initial.pore_pressure.hydrostatic",
           "water_table");
 }
+
+TEST_CASE("initial fields from another run's output: the same layout bit for bit, a finer one interpolated",
+          "[initial]") {
+  TempDir dir;
+  write_file(dir.file("column.yaml"), kScene);
+  // The spin-up: the column's profile, then one step of conduction (fields at t = 0 and 1).
+  const auto spin = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("spin"));
+  INFO(spin.output);
+  REQUIRE(spin.exit_code == 0);
+  const Frame before = first_frame(dir.file("spin"));
+  const std::string from = "regions.0.initial.temperature={from: " + dir.file("spin");
+
+  SECTION("the same particles take the stored values exactly: the first frame and the last") {
+    const auto r = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("same") + " --set '" + from +
+                                ", frame: first}'");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const Frame f = first_frame(dir.file("same"));
+    REQUIRE(f.y == before.y);
+    CHECK(f.temperature == before.temperature);
+    // The last frame (the default) is the profile after a step of conduction: another field.
+    const auto last = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("last") + " --set '" + from +
+                                   "}' --set time.end=0.5 --set time.dt=0.5");
+    REQUIRE(last.exit_code == 0);
+    CHECK(first_frame(dir.file("last")).temperature != before.temperature);
+  }
+  SECTION("a finer layout gets the piecewise-linear log within what a linear fit of its kinks leaves") {
+    const auto r = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("fine") + " --set '" + from +
+                                ", frame: 0}' --set grid.particles_per_cell=3");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const Frame f = first_frame(dir.file("fine"));
+    REQUIRE(f.y.size() == 180);  // 3 × 3 per cell
+    double worst = 0;
+    for (std::size_t p = 0; p < f.y.size(); ++p)
+      worst = std::max(worst, std::abs(f.temperature[p] - logged_temperature(f.y[p])));
+    // The log's slope is at most 6 °C/m, the stored points 0.05 m apart: exact away from its
+    // two kinks, and within slope × spacing / 2 next to them.
+    CHECK(worst < 6.0 * 0.05 / 2);
+    CHECK(worst > 0);  // the kinks do show
+  }
+  SECTION("a bad frame, a missing field, a missing run and ground the run did not cover: one line each") {
+    const auto refused = [&](const std::string& set, const std::string& path, const std::string& text) {
+      const auto r = run_frostmpm("check " + dir.file("column.yaml") + " --set '" + set + "'");
+      INFO(r.output);
+      CHECK(r.exit_code == 2);
+      CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+      CHECK(r.output.find(path) != std::string::npos);
+      CHECK(r.output.find(text) != std::string::npos);
+    };
+    const std::string t = "regions.0.initial.temperature";
+    refused(from + ", frame: 2}", t + ".frame", "not among the 2 frames");
+    refused(from + ", frame: latest}", t + ".frame", "valid: last, first");
+    refused(from + ", field: salinity}", t + ".field", "no field 'salinity'; it has: pore_pressure, temperature");
+    refused(from + "/nowhere}", t + ".from", "there is no");
+    refused(from + ", stride: 2}", t + ".stride", "stride");
+    // A column twice as tall: its upper half is 1 m from the stored points.
+    const auto r = run_frostmpm("check " + dir.file("column.yaml") + " --set '" + from +
+                                "}' --set grid.cells=[1,40] --set 'regions.0.shape.box.max=[0.1,4.0]'");
+    INFO(r.output);
+    CHECK(r.exit_code == 2);
+    CHECK(r.output.find("does not cover the same ground") != std::string::npos);
+  }
+}

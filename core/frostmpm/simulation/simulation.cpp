@@ -12,9 +12,11 @@
 
 #include "frostmpm/io/log.hpp"
 #include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/io/particle_field_reader.hpp"
 #include "frostmpm/io/particle_field_writer.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "frostmpm/scene/expression.hpp"
+#include "frostmpm/scene/scattered_field.hpp"
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/run_budget.hpp"
 
@@ -311,6 +313,83 @@ void assign_profile(const ConfigNode& node, const ParticleRange& range, std::spa
 }
 }  // namespace
 
+/// `{from: OUT, frame: last|first|INDEX, field: NAME}`: components [k, k + n) of `field` on the
+/// particles of `range` from a frame of another run's fields.h5, interpolated to their
+/// positions (ScatteredField). The stored field (by default the same name) has n components,
+/// or as many as `field` has and its columns [k, k + n) are taken. Calls set(p, j, value).
+template <class Set>
+void Simulation::assign_from_run(const ConfigNode& node, const std::string& field, const ParticleRange& range,
+                                 int k, int n, Set&& set) {
+  const ConfigNode from = node.child("from");
+  std::unique_ptr<ParticleFieldReader> reader;
+  try {
+    reader = std::make_unique<ParticleFieldReader>(from.as_string());
+  } catch (const std::runtime_error& e) {
+    throw from.error(e.what());
+  }
+  if (reader->dim() != kDim)
+    throw from.error(reader->path() + " holds a " + std::to_string(reader->dim()) + "-D run, this scene is " +
+                     std::to_string(kDim) + "-D");
+  const auto& frames = reader->frames();
+  const ParticleFieldReader::Frame* frame = &frames.back();
+  if (node.has("frame")) {
+    const ConfigNode f = node.child("frame");
+    const std::string text = f.as_string();
+    const std::string valid = "valid: last, first, or a frame index 0.." + std::to_string(frames.size() - 1) +
+                              " (negative counts from the last)";
+    if (text == "first") frame = &frames.front();
+    else if (text != "last") {
+      long index = 0;
+      try {
+        std::size_t used = 0;
+        index = std::stol(text, &used);
+        if (used != text.size()) throw std::invalid_argument(text);
+      } catch (const std::exception&) {
+        throw f.error("unknown frame '" + text + "'; " + valid);
+      }
+      const long count = static_cast<long>(frames.size());
+      if (index < -count || index >= count)
+        throw f.error("frame " + text + " is not among the " + std::to_string(count) + " frames of " + reader->path() +
+                      "; " + valid);
+      frame = &frames[std::size_t(index < 0 ? index + count : index)];
+    }
+  }
+  const std::string stored = node.has("field") ? node.child("field").as_string() : field;
+  node.finish({"from", "frame", "field"});
+  const ConfigNode& where = node.has("field") ? node.child("field") : from;
+  int stored_components = 0;
+  std::vector<double> values;
+  try {
+    stored_components = reader->components(*frame, stored);
+    values = reader->values(*frame, stored);
+  } catch (const std::runtime_error& e) {
+    throw where.error(e.what());
+  }
+  const int c = particles_.components(field);
+  int first = 0;
+  if (stored_components == c && n < c) first = k;  // one component of a stored vector
+  else if (stored_components != n)
+    throw where.error("field '" + stored + "' of " + reader->path() + " has " + std::to_string(stored_components) +
+                      " components; '" + field + "' takes " + std::to_string(n));
+  // Only the columns taken go into the interpolation.
+  std::vector<double> taken(frame->count * std::size_t(n));
+  for (std::size_t q = 0; q < frame->count; ++q)
+    for (int j = 0; j < n; ++j) taken[q * n + j] = values[q * std::size_t(stored_components) + std::size_t(first + j)];
+  const ScatteredField<kDim> source(reader->positions(*frame), taken, n);
+  const auto pos = particles_.field("position");
+  std::vector<double> out(static_cast<std::size_t>(n));
+  for (std::size_t p = range.begin; p < range.end; ++p) {
+    std::array<double, kDim> x;
+    for (int d = 0; d < kDim; ++d) x[d] = pos[p * kDim + d];
+    if (!source.evaluate(x, out))
+      throw from.error(describe_particle(p) + " lies " + number_text(source.nearest_distance(x), 4) +
+                       " m from the nearest material point of the frame at t = " + number_text(frame->time) + " s of " +
+                       reader->path() + " (its points are " + number_text(source.spacing(), 4) +
+                       " m apart): the two runs' material does not cover the same ground");
+    for (int j = 0; j < n; ++j) set(p, j, out[std::size_t(j)]);
+  }
+}
+
 /// Regions' `initial:` values: a state field, or one component of a vector state field
 /// ("solid_velocity.x"), set to a number or to an expression of the position,
 /// {expression: "0.1*sin(pi*x/50)"} with variables x, y.
@@ -376,6 +455,14 @@ void Simulation::apply_initial_values() {
           });
           return;
         }
+        if (value_node.has("from")) {
+          assign_from_run(value_node, field, init.range, k, n, [&](std::size_t p, int j, double value) {
+            if (const auto why = problem(value); !why.empty())
+              throw value_node.error(at_particle(p) + "the value taken from the run " + number_text(value) + " " + why);
+            column[p * c + std::size_t(k + j)] = value;
+          });
+          return;
+        }
         if (value_node.has("hydrostatic")) {
           if (field != "pore_pressure")
             throw value_node.child("hydrostatic").error("hydrostatic sets pore_pressure only, not '" + key + "'");
@@ -397,6 +484,10 @@ void Simulation::apply_initial_values() {
             store(p, rho_g * (level - pos[p * kDim + kDim - 1]), h, at_particle(p) + "the hydrostatic pressure ");
           return;
         }
+        if (!value_node.has("expression"))
+          throw value_node.error("expected a number, {expression: ...}, {table: ...}, {from: OUT}" +
+                                 std::string(field == "pore_pressure" ? " or {hydrostatic: ...}" : "") +
+                                 "; got a map with " + join(value_node.keys()));
         const ConfigNode text = value_node.child("expression");
         value_node.finish({"expression"});
         Expression f;

@@ -150,6 +150,9 @@ class Simulation final : public Kernel<kDim> {
   /// Nodal fields kept between steps, for checkpoints.
   std::vector<PersistentArray> carried_node_fields();
   void apply_initial_values();
+  template <class Set>
+  void assign_from_run(const ConfigNode& node, const std::string& field, const ParticleRange& range, int k, int n,
+                       Set&& set);
   /// Positions moved: GIMP domains and volumes from the deformation gradient, stencils.
   void update_geometry();
   void update_stencil();
