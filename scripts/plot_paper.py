@@ -9,6 +9,7 @@
     /usr/bin/python3 scripts/plot_paper.py rock OUT [OUT_beta0 OUT_beta4.5e-5] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py stabilization OUT_tau0 OUT_tau0.1 OUT_tau0.5 OUT_tau1 [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py footing_thermal OUT_0.2 OUT_0.1 [OUT_0.05] [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py footing OUT_unthawed OUT_thawing OUT_prethawed [...] [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
@@ -27,7 +28,10 @@ x axis (Fig. 18, _profiles). stabilization: the pore pressure of runs with τ = 
 (App. C) at one frame (the last unless --frame). footing_thermal: the thermal mesh study of the
 strip footing on thawing ground (Sec. 5.3.2, configs/paper/strip_footing_thermal.yaml): the last
 frame's temperature with the −1, 0 and 1 °C lines per mesh (Fig. 24A–C), the temperature at A and B
-and the thaw depths against time, one line per mesh (Fig. 24E–F). Each OUT is a run folder (metrics.csv, fields.h5).
+and the thaw depths against time, one line per mesh (Fig. 24E–F). footing: the THM runs of the
+strip footing (configs/paper/strip_footing.yaml): footing pressure against d/B with the
+Prandtl–Reissner pressure of the thawed soil (Fig. 27), and each run's plastic deviatoric strain
+at its last frame with the −1 and 0 °C lines (Figs. 25–26). Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -348,11 +352,45 @@ def footing_thermal(folders, png):
     frostplot.save(fig, png)
 
 
+def reissner(c, phi_deg, q0):
+    """Prandtl–Reissner bearing pressure c N_c + q0 N_q of a weightless soil (associated flow)."""
+    t = np.tan(np.radians(phi_deg))
+    n_q = np.exp(np.pi * t) * np.tan(np.radians(45 + phi_deg / 2)) ** 2
+    return c * (n_q - 1) / t + q0 * n_q
+
+
+def footing(folders, png):
+    """Resistance against settlement (Fig. 27) and the deviatoric plastic strain of each run's
+    last frame with its 0 °C line (Figs. 25–26)."""
+    width = 1.2
+    n = len(folders)
+    fig, axes = plt.subplots(1, n + 1, figsize=(5 * (n + 1), 4.2))
+    a = axes[0]
+    for folder in folders:
+        m = metrics(folder)
+        a.plot(m["footing_displacement"] / width, m["footing_pressure"] / 1e3, label=os.path.basename(folder.rstrip("/")))
+    for c, style in ((20e3, "--"), (10e3, ":")):
+        a.axhline(reissner(c, 30, 20e3) / 1e3, color="k", ls=style, lw=0.8,
+                  label=f"Prandtl–Reissner, thawed, c = {c / 1e3:.0f} kPa")
+    a.set(xlabel="d / B", ylabel="footing pressure [kPa]", title="resistance (Fig. 27)")
+    a.legend(fontsize=7)
+    for ax, folder in zip(axes[1:], folders):
+        fr = frostplot.read_fields.read_frames(folder)[-1]
+        frostplot.field_panel(ax, fig, fr, "plastic_deviatoric_strain", levels=np.linspace(0, 1, 11),
+                              label="plastic deviatoric strain")
+        x, y = fr["coordinates"][:, 0], fr["coordinates"][:, 1]
+        T = fr["fields"]["temperature"]
+        if T.min() < 0 < T.max():
+            ax.tricontour(x, y, T, levels=[-1, 0], colors=["b", "k"], linewidths=1)
+        ax.set(xlim=(0, 5), ylim=(2, 6.4), title=f"{os.path.basename(folder.rstrip('/'))}: t = {fr['time']:.2f} s")
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
-                                                      "footing_thermal"])
+                                                      "footing_thermal", "footing"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -372,6 +410,8 @@ def main():
         stabilization(args.folders, png, args.frame)
     elif args.figure == "footing_thermal":
         footing_thermal(args.folders, png)
+    elif args.figure == "footing":
+        footing(args.folders, png)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")
