@@ -105,7 +105,7 @@ TEST_CASE("ScatteredField: coinciding points exactly, linear fields exactly, edg
   }
 }
 
-TEST_CASE("ScatteredField: points in a line fall back to the nearest point; 3-D works alike", "[initial]") {
+TEST_CASE("ScatteredField: points in a line fall back to the nearest point, and 3-D works alike", "[initial]") {
   const std::vector<double> row = {0.0, 0.0, 1.0, 0.0, 2.0, 0.0, 3.0, 0.0};
   const std::vector<double> v = {10, 11, 12, 13};
   const ScatteredField<2> line(row, v, 1);
