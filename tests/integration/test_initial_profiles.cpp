@@ -71,14 +71,29 @@ double logged_temperature(double y) {
   return -3.0;
 }
 
+/// `frostmpm check SCENE --set SET` is refused with one line naming `path` and containing `text`.
+void refused(const std::string& scene, const std::string& set, const std::string& path, const std::string& text) {
+  const auto r = run_frostmpm("check " + scene + " --set '" + set + "'");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
+  CHECK(r.output.find(path) != std::string::npos);
+  CHECK(r.output.find(text) != std::string::npos);
+}
+
+/// `frostmpm run SCENE -o OUT ARGS`, required to succeed.
+void runs(const std::string& scene, const std::string& out, const std::string& args = "") {
+  const auto r = run_frostmpm("run " + scene + " -o " + out + args);
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+}
+
 }  // namespace
 
 TEST_CASE("initial fields from a depth table and from a water table", "[initial]") {
   TempDir dir;
   write_file(dir.file("column.yaml"), kScene);
-  const auto r = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("out"));
-  INFO(r.output);
-  REQUIRE(r.exit_code == 0);
+  runs(dir.file("column.yaml"), dir.file("out"));
   const Frame f = first_frame(dir.file("out"));
   REQUIRE(f.y.size() == 80);
   for (std::size_t p = 0; p < f.y.size(); ++p) {
@@ -89,11 +104,8 @@ TEST_CASE("initial fields from a depth table and from a water table", "[initial]
   }
 
   SECTION("the same profile given along y") {
-    const auto along = run_frostmpm(
-        "run " + dir.file("column.yaml") + " -o " + dir.file("along") +
-        " --set 'regions.0.initial.temperature={table: [[0.5, -3.0], [1.5, -1.0], [2.0, 2.0]], along: y}'");
-    INFO(along.output);
-    REQUIRE(along.exit_code == 0);
+    runs(dir.file("column.yaml"), dir.file("along"),
+         " --set 'regions.0.initial.temperature={table: [[0.5, -3.0], [1.5, -1.0], [2.0, 2.0]], along: y}'");
     const Frame g = first_frame(dir.file("along"));
     for (std::size_t p = 0; p < g.y.size(); ++p) CHECK(g.temperature[p] == Approx(f.temperature[p]).margin(1e-12));
   }
@@ -103,12 +115,7 @@ TEST_CASE("bad initial tables and water tables are one line naming the key", "[i
   TempDir dir;
   write_file(dir.file("column.yaml"), kScene);
   const auto refused = [&](const std::string& set, const std::string& path, const std::string& text) {
-    const auto r = run_frostmpm("check " + dir.file("column.yaml") + " --set '" + set + "'");
-    INFO(r.output);
-    CHECK(r.exit_code == 2);
-    CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
-    CHECK(r.output.find(path) != std::string::npos);
-    CHECK(r.output.find(text) != std::string::npos);
+    ::refused(dir.file("column.yaml"), set, path, text);
   };
   const std::string t = "regions.0.initial.temperature=";
   refused(t + "{table: [[0, 1], [0, 2]], along: y}", "regions.0.initial.temperature.table", "increase strictly");
@@ -127,31 +134,21 @@ TEST_CASE("initial fields from another run's output: the same layout bit for bit
   TempDir dir;
   write_file(dir.file("column.yaml"), kScene);
   // The spin-up: the column's profile, then one step of conduction (fields at t = 0 and 1).
-  const auto spin = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("spin"));
-  INFO(spin.output);
-  REQUIRE(spin.exit_code == 0);
+  runs(dir.file("column.yaml"), dir.file("spin"));
   const Frame before = first_frame(dir.file("spin"));
   const std::string from = "regions.0.initial.temperature={from: " + dir.file("spin");
 
   SECTION("the same particles take the stored values exactly: the first frame and the last") {
-    const auto r = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("same") + " --set '" + from +
-                                ", frame: first}'");
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
+    runs(dir.file("column.yaml"), dir.file("same"), " --set '" + from + ", frame: first}'");
     const Frame f = first_frame(dir.file("same"));
     REQUIRE(f.y == before.y);
     CHECK(f.temperature == before.temperature);
     // The last frame (the default) is the profile after a step of conduction: another field.
-    const auto last = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("last") + " --set '" + from +
-                                   "}' --set time.end=0.5 --set time.dt=0.5");
-    REQUIRE(last.exit_code == 0);
+    runs(dir.file("column.yaml"), dir.file("last"), " --set '" + from + "}' --set time.end=0.5 --set time.dt=0.5");
     CHECK(first_frame(dir.file("last")).temperature != before.temperature);
   }
   SECTION("a finer layout gets the piecewise-linear log within what a linear fit of its kinks leaves") {
-    const auto r = run_frostmpm("run " + dir.file("column.yaml") + " -o " + dir.file("fine") + " --set '" + from +
-                                ", frame: 0}' --set grid.particles_per_cell=3");
-    INFO(r.output);
-    REQUIRE(r.exit_code == 0);
+    runs(dir.file("column.yaml"), dir.file("fine"), " --set '" + from + ", frame: 0}' --set grid.particles_per_cell=3");
     const Frame f = first_frame(dir.file("fine"));
     REQUIRE(f.y.size() == 180);  // 3 × 3 per cell
     double worst = 0;
@@ -164,12 +161,7 @@ TEST_CASE("initial fields from another run's output: the same layout bit for bit
   }
   SECTION("a bad frame, a missing field, a missing run and ground the run did not cover: one line each") {
     const auto refused = [&](const std::string& set, const std::string& path, const std::string& text) {
-      const auto r = run_frostmpm("check " + dir.file("column.yaml") + " --set '" + set + "'");
-      INFO(r.output);
-      CHECK(r.exit_code == 2);
-      CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);
-      CHECK(r.output.find(path) != std::string::npos);
-      CHECK(r.output.find(text) != std::string::npos);
+      ::refused(dir.file("column.yaml"), set, path, text);
     };
     const std::string t = "regions.0.initial.temperature";
     refused(from + ", frame: 2}", t + ".frame", "not among the 2 frames");

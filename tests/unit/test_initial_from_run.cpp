@@ -54,10 +54,12 @@ TEST_CASE("ParticleFieldReader: frames in step order, positions and fields as wr
   CHECK(last.step == 50);
   CHECK(last.time == 5.0);
   CHECK(reader.positions(last) == pos);
-  CHECK(reader.values(last, "temperature") == T);
-  CHECK(reader.components(last, "solid_velocity") == 2);
-  CHECK(reader.values(last, "solid_velocity") == v);  // the writer's padding to 3 columns dropped
-  CHECK_THROWS_WITH(reader.values(last, "pressure"), Contains("no field 'pressure'") && Contains("temperature"));
+  CHECK(reader.field(last, "temperature").values == T);
+  const auto velocity = reader.field(last, "solid_velocity");
+  CHECK(velocity.components == 2);
+  CHECK(velocity.values == v);  // the writer's padding to 3 columns dropped
+  CHECK_THROWS_WITH(reader.field(last, "pressure"),
+                    Contains("the frame at t = 5 s") && Contains("no field 'pressure'; it has: solid_velocity, temperature"));
   CHECK_THROWS_WITH(ParticleFieldReader(dir.path() + "/nothing"), Contains("there is no"));
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 
 #include "frostmpm/io/hdf5_support.hpp"
@@ -24,27 +25,34 @@ ParticleFieldReader::ParticleFieldReader(const std::string& dir) : impl_(std::ma
     impl_->file = hdf5::open_file(impl_->path, /*writable=*/false);
     const hdf5::Id file = impl_->file.get();
     impl_->dim = static_cast<int>(hdf5::read_integer_attribute(file, "dim"));
-    for (const auto& name : hdf5::child_names(file)) {
-      if (name.rfind("step_", 0) != 0) continue;
-      // A frame a crash cut short (no readable attributes or coordinates) is skipped.
-      try {
-        const hdf5::Handle group = hdf5::open_group(file, name);
-        Frame f;
-        f.group = name;
-        f.time = hdf5::read_real_attribute(group.get(), "time");
-        f.step = static_cast<long>(hdf5::read_integer_attribute(group.get(), "step"));
-        f.count = static_cast<std::size_t>(hdf5::read_integer_attribute(group.get(), "count"));
-        hdf5::dataset_shape(group.get(), "coordinates");
-        impl_->frames.push_back(f);
-      } catch (const std::runtime_error&) {
-      }
-    }
+    impl_->frames = list_frames(file);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(impl_->path + " is not a readable FrostMPM field file (" + e.what() + ")");
   }
-  std::sort(impl_->frames.begin(), impl_->frames.end(),
-            [](const Frame& a, const Frame& b) { return a.step < b.step; });
   if (impl_->frames.empty()) throw std::runtime_error(impl_->path + " holds no complete frame");
+}
+
+std::vector<ParticleFieldReader::Frame> ParticleFieldReader::list_frames(std::int64_t file,
+                                                                          std::vector<std::string>* torn) {
+  std::vector<Frame> frames;
+  for (const auto& name : hdf5::child_names(file)) {
+    if (name.rfind("step_", 0) != 0) continue;
+    try {
+      const hdf5::Handle group = hdf5::open_group(file, name);
+      Frame f;
+      f.group = name;
+      f.time = hdf5::read_real_attribute(group.get(), "time");
+      f.step = static_cast<long>(hdf5::read_integer_attribute(group.get(), "step"));
+      f.count = static_cast<std::size_t>(hdf5::read_integer_attribute(group.get(), "count"));
+      hdf5::dataset_shape(group.get(), "coordinates");
+      frames.push_back(f);
+    } catch (const std::runtime_error&) {
+      if (torn) torn->push_back(name);
+    }
+  }
+  // Group names sort by step only up to six digits.
+  std::sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) { return a.step < b.step; });
+  return frames;
 }
 
 ParticleFieldReader::~ParticleFieldReader() = default;
@@ -83,24 +91,22 @@ std::vector<std::string> ParticleFieldReader::field_names(const Frame& frame) co
   return names;
 }
 
-int ParticleFieldReader::components(const Frame& frame, const std::string& field) const {
+ParticleFieldReader::Field ParticleFieldReader::field(const Frame& frame, const std::string& name) const {
   const hdf5::QuietErrors quiet;
   const hdf5::Handle group = hdf5::open_group(impl_->file.get(), frame.group);
-  if (!hdf5::exists(group.get(), field)) {
-    std::string have;
-    for (const auto& name : field_names(frame)) have += (have.empty() ? "" : ", ") + name;
-    throw std::runtime_error("the frame at t = " + std::to_string(frame.time) + " s of " + impl_->path +
-                             " has no field '" + field + "'; it has: " + (have.empty() ? "none" : have));
+  if (!hdf5::exists(group.get(), name)) {
+    std::ostringstream msg;
+    msg << "the frame at t = " << frame.time << " s of " << impl_->path << " has no field '" << name << "'; it has: ";
+    const auto have = field_names(frame);
+    for (std::size_t i = 0; i < have.size(); ++i) msg << (i ? ", " : "") << have[i];
+    if (have.empty()) msg << "none";
+    throw std::runtime_error(msg.str());
   }
-  const auto shape = hdf5::dataset_shape(group.get(), field);
-  return hdf5::dataset_components(group.get(), field, shape.size() == 2 ? static_cast<int>(shape[1]) : 1);
-}
-
-std::vector<double> ParticleFieldReader::values(const Frame& frame, const std::string& field) const {
-  const int c = components(frame, field);
-  const hdf5::QuietErrors quiet;
-  const hdf5::Handle group = hdf5::open_group(impl_->file.get(), frame.group);
-  return read_columns(group.get(), field, frame.count, std::size_t(c));
+  const auto shape = hdf5::dataset_shape(group.get(), name);
+  Field f;
+  f.components = hdf5::dataset_components(group.get(), name, shape.size() == 2 ? static_cast<int>(shape[1]) : 1);
+  f.values = read_columns(group.get(), name, frame.count, std::size_t(f.components));
+  return f;
 }
 
 }  // namespace frostmpm

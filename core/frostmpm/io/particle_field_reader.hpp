@@ -3,6 +3,7 @@
 // a frame's particle positions and fields (`initial: {temperature: {from: OUT}}` starts a new
 // run from another run's output). hdf5.h stays in the .cpp.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +21,10 @@ class ParticleFieldReader {
   /// Opens <dir>/fields.h5. std::runtime_error (one line naming the file) if there is none or
   /// it is not a FrostMPM field file.
   explicit ParticleFieldReader(const std::string& dir);
+  /// The complete frames of an open field file (an hdf5::Id), in step order. A frame a crash
+  /// cut short (its group, attributes or coordinates unreadable) is left out, and its group
+  /// name added to `torn` when given (ParticleFieldWriter::reopen deletes those).
+  static std::vector<Frame> list_frames(std::int64_t file, std::vector<std::string>* torn = nullptr);
   ~ParticleFieldReader();
   ParticleFieldReader(const ParticleFieldReader&) = delete;
   ParticleFieldReader& operator=(const ParticleFieldReader&) = delete;
@@ -32,12 +37,13 @@ class ParticleFieldReader {
   std::vector<double> positions(const Frame& frame) const;
   /// The fields a frame holds, in name order.
   std::vector<std::string> field_names(const Frame& frame) const;
-  /// Components of one field as written (the writer pads 2-D vectors to 3 columns; this is
-  /// the count before padding).
-  int components(const Frame& frame, const std::string& field) const;
-  /// A field of a frame: count × components(frame, field), row-major, padding dropped.
-  /// std::runtime_error naming the field and the frame when the frame does not hold it.
-  std::vector<double> values(const Frame& frame, const std::string& field) const;
+  struct Field {
+    int components = 1;          ///< as written (before the writer's padding of 2-D vectors to 3)
+    std::vector<double> values;  ///< count × components, row-major
+  };
+  /// A field of a frame. std::runtime_error naming the field and the frame, and listing the
+  /// fields it holds, when the frame does not hold it.
+  Field field(const Frame& frame, const std::string& name) const;
 
  private:
   struct Impl;

@@ -17,6 +17,7 @@
 
 #include "frostmpm/io/hdf5_support.hpp"
 #include "frostmpm/io/output_dir.hpp"
+#include "frostmpm/io/particle_field_reader.hpp"
 
 namespace frostmpm {
 
@@ -267,29 +268,19 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
   if (stored_dim != dim)
     throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored_dim) +
                              "-D frames, not " + std::to_string(dim) + "-D");
-  // Frames in step order (group names sort by step only up to six digits).
-  // A frame a SIGKILL cut short may have its link but no readable group or step: it is newer
-  // than every complete frame (frames are written in order), so it is dropped with the rest.
-  std::vector<std::pair<long, std::string>> stored;
+  // A frame a SIGKILL cut short may have its link but no readable group, step or coordinates:
+  // it is newer than every complete frame (frames are written in order), so it is dropped with
+  // the rest.
   std::vector<std::string> torn;
-  for (const auto& name : hdf5::child_names(file)) {
-    if (name.rfind("step_", 0) != 0) continue;
-    try {
-      const hdf5::Handle group = hdf5::open_group(file, name);
-      stored.emplace_back(static_cast<long>(hdf5::read_integer_attribute(group.get(), "step")), name);
-    } catch (const std::runtime_error&) {
-      torn.push_back(name);
-    }
-  }
-  std::sort(stored.begin(), stored.end());
+  const auto stored = ParticleFieldReader::list_frames(file, &torn);
   for (const auto& name : torn)
     hdf5::check(H5Ldelete(file, name.c_str(), H5P_DEFAULT), "deleting the cut-short frame " + name);
   if (stored.size() < keep_frames)
     throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored.size()) +
                              " frames, fewer than the " + std::to_string(keep_frames) + " to keep");
   for (std::size_t i = keep_frames; i < stored.size(); ++i)
-    hdf5::check(H5Ldelete(file, stored[i].second.c_str(), H5P_DEFAULT), "deleting " + stored[i].second);
-  for (std::size_t i = 0; i < keep_frames; ++i) impl->add_to_xdmf(read_layout(file, stored[i].second), stored[i].first);
+    hdf5::check(H5Ldelete(file, stored[i].group.c_str(), H5P_DEFAULT), "deleting " + stored[i].group);
+  for (std::size_t i = 0; i < keep_frames; ++i) impl->add_to_xdmf(read_layout(file, stored[i].group), stored[i].step);
   impl->flush();
   impl->write_xdmf();
   return ParticleFieldWriter(std::move(impl));

@@ -9,11 +9,10 @@
 namespace frostmpm {
 
 template <int Dim>
-ScatteredField<Dim>::ScatteredField(std::span<const double> points, std::span<const double> values, int components)
-    : components_(components), count_(points.size() / Dim), points_(points.begin(), points.end()),
-      values_(values.begin(), values.end()) {
-  if (count_ == 0 || points.size() != count_ * Dim || components < 1 ||
-      values.size() != count_ * std::size_t(components))
+ScatteredField<Dim>::ScatteredField(std::vector<double> points, std::vector<double> values, int components)
+    : components_(components), count_(points.size() / Dim), points_(std::move(points)), values_(std::move(values)) {
+  if (count_ == 0 || points_.size() != count_ * Dim || components < 1 ||
+      values_.size() != count_ * std::size_t(components))
     throw std::invalid_argument("ScatteredField: points (n × dim) and values (n × components) disagree or are empty");
   std::array<double, Dim> lo, hi;
   lo.fill(std::numeric_limits<double>::infinity());
@@ -46,8 +45,7 @@ ScatteredField<Dim>::ScatteredField(std::span<const double> points, std::span<co
     for (int d = 0; d < Dim; ++d) x[d] = points_[p * Dim + d];
     double best = std::numeric_limits<double>::infinity();
     for_points_near(x, 2, [&](std::size_t q) {
-      double r2 = 0;
-      for (int d = 0; d < Dim; ++d) r2 += (points_[q * Dim + d] - x[d]) * (points_[q * Dim + d] - x[d]);
+      const double r2 = distance2(q, x);
       if (q != p && r2 > 0) best = std::min(best, r2);
     });
     if (std::isfinite(best)) nearest.push_back(std::sqrt(best));
@@ -78,6 +76,13 @@ void ScatteredField<Dim>::build_buckets(const std::array<double, Dim>& hi) {
   bucket_points_.resize(count_);
   std::vector<std::size_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
   for (std::size_t p = 0; p < count_; ++p) bucket_points_[fill[flat(p)]++] = p;
+}
+
+template <int Dim>
+double ScatteredField<Dim>::distance2(std::size_t p, const std::array<double, Dim>& x) const {
+  double r2 = 0;
+  for (int d = 0; d < Dim; ++d) r2 += (points_[p * Dim + d] - x[d]) * (points_[p * Dim + d] - x[d]);
+  return r2;
 }
 
 template <int Dim>
@@ -128,12 +133,8 @@ bool ScatteredField<Dim>::evaluate(const std::array<double, Dim>& x, std::span<d
       // Offsets in units of the radius keep the normal matrix well scaled.
       Eigen::Matrix<double, n, 1> row;
       row(0) = 1;
-      double r2 = 0;
-      for (int d = 0; d < Dim; ++d) {
-        const double dx = points_[p * Dim + d] - x[d];
-        row(d + 1) = dx / r;
-        r2 += dx * dx;
-      }
+      for (int d = 0; d < Dim; ++d) row(d + 1) = (points_[p * Dim + d] - x[d]) / r;
+      const double r2 = distance2(p, x);
       if (r2 < nearest2) {
         nearest2 = r2;
         nearest = p;
@@ -167,11 +168,7 @@ bool ScatteredField<Dim>::evaluate(const std::array<double, Dim>& x, std::span<d
 template <int Dim>
 double ScatteredField<Dim>::nearest_distance(const std::array<double, Dim>& x) const {
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t p = 0; p < count_; ++p) {
-    double r2 = 0;
-    for (int d = 0; d < Dim; ++d) r2 += (points_[p * Dim + d] - x[d]) * (points_[p * Dim + d] - x[d]);
-    best = std::min(best, r2);
-  }
+  for (std::size_t p = 0; p < count_; ++p) best = std::min(best, distance2(p, x));
   return std::sqrt(best);
 }
 

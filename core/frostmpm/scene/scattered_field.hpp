@@ -19,8 +19,8 @@ namespace frostmpm {
 template <int Dim>
 class ScatteredField {
  public:
-  /// points: n × Dim, values: n × components (row-major); copied. n ≥ 1.
-  ScatteredField(std::span<const double> points, std::span<const double> values, int components);
+  /// points: n × Dim, values: n × components (row-major), taken over. n ≥ 1.
+  ScatteredField(std::vector<double> points, std::vector<double> values, int components);
 
   int components() const { return components_; }
   /// The spacing the fit's radius is measured in.
@@ -41,6 +41,7 @@ class ScatteredField {
   std::vector<std::size_t> bucket_start_, bucket_points_;  ///< CSR: the points of each bucket
 
   void build_buckets(const std::array<double, Dim>& hi);
+  double distance2(std::size_t p, const std::array<double, Dim>& x) const;
   long bucket_of(int d, double x) const;
   template <class Visit>
   void for_points_near(const std::array<double, Dim>& x, long rings, Visit&& visit) const;

@@ -356,26 +356,27 @@ void Simulation::assign_from_run(const ConfigNode& node, const std::string& fiel
   }
   const std::string stored = node.has("field") ? node.child("field").as_string() : field;
   node.finish({"from", "frame", "field"});
-  const ConfigNode& where = node.has("field") ? node.child("field") : from;
-  int stored_components = 0;
-  std::vector<double> values;
+  const ConfigNode where = node.has("field") ? node.child("field") : from;
+  ParticleFieldReader::Field stored_field;
   try {
-    stored_components = reader->components(*frame, stored);
-    values = reader->values(*frame, stored);
+    stored_field = reader->field(*frame, stored);
   } catch (const std::runtime_error& e) {
     throw where.error(e.what());
   }
-  const int c = particles_.components(field);
-  int first = 0;
-  if (stored_components == c && n < c) first = k;  // one component of a stored vector
-  else if (stored_components != n)
-    throw where.error("field '" + stored + "' of " + reader->path() + " has " + std::to_string(stored_components) +
+  const int sc = stored_field.components;
+  std::vector<double> taken;
+  if (sc == n) {
+    taken = std::move(stored_field.values);
+  } else if (sc == particles_.components(field)) {
+    // One component of a stored vector: only its column goes into the interpolation.
+    taken.resize(frame->count * std::size_t(n));
+    for (std::size_t q = 0; q < frame->count; ++q)
+      for (int j = 0; j < n; ++j) taken[q * n + j] = stored_field.values[q * std::size_t(sc) + std::size_t(k + j)];
+  } else {
+    throw where.error("field '" + stored + "' of " + reader->path() + " has " + std::to_string(sc) +
                       " components; '" + field + "' takes " + std::to_string(n));
-  // Only the columns taken go into the interpolation.
-  std::vector<double> taken(frame->count * std::size_t(n));
-  for (std::size_t q = 0; q < frame->count; ++q)
-    for (int j = 0; j < n; ++j) taken[q * n + j] = values[q * std::size_t(stored_components) + std::size_t(first + j)];
-  const ScatteredField<kDim> source(reader->positions(*frame), taken, n);
+  }
+  const ScatteredField<kDim> source(reader->positions(*frame), std::move(taken), n);
   const auto pos = particles_.field("position");
   std::vector<double> out(static_cast<std::size_t>(n));
   for (std::size_t p = range.begin; p < range.end; ++p) {
