@@ -529,6 +529,7 @@ std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const
           {"hydraulic.relative_residual_max", residual_max_},
           {"hydraulic.preconditioner_updates", double(preconditioner_updates_)},
           {"hydraulic.solve_seconds", solve_seconds_},
+          {"hydraulic.preconditioner_seconds", preconditioner_seconds_},
           {"hydraulic.source_volume", source_volume_},
           {"hydraulic.boundary_inflow_volume", boundary_inflow_},
           {"hydraulic.water_removed_volume", removed_water_}};

@@ -173,6 +173,7 @@ class HydraulicPhysics final : public Physics {
   double time_ = 0, dt_ = 0;
   long solves_ = 0, iterations_total_ = 0, iterations_max_ = 0;
   double residual_max_ = 0, solve_seconds_ = 0;
+  double preconditioner_seconds_ = 0;  ///< of solve_seconds_: uploading values and building or refreshing the preconditioner
   double source_volume_ = 0;    ///< water volume the phase change and thermal expansion removed [m³ per m]
   double removed_water_ = 0;  ///< liquid water volume of the particles removed after leaving the grid
   double boundary_inflow_ = 0;  ///< water volume that entered through pressure and flux boundaries

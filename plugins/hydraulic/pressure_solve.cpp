@@ -294,11 +294,21 @@ void HydraulicPhysics::add_stabilization() {
 }
 
 /// Σ V_p τ/(2G_p) of the particles in each cell: changes only when particles move.
+///
+/// Only cells the material fills to at least kProjectionMinimumFill (by particle volume) take the
+/// projection. The exact bilinear integral spans the whole cell; in a cell at a free surface
+/// holding one particle of four it couples, as strongly as the particle's volume allows, nodes
+/// the material barely reaches and whose other coefficients are tiny. There it excited a local
+/// mode that grew by about 15 % a step (rock freezing on 1 cm cells: the cell at the borehole
+/// wall with one particle, frozen, its pore pressure running to −760 MPa in 30 steps). A cell
+/// so sparsely filled has no checkerboard of its own to suppress.
 void HydraulicPhysics::update_cell_stabilization() {
+  constexpr double kProjectionMinimumFill = 0.4;
   const auto& grid = kernel_->grid();
   const auto x = position_.values();
   const auto vol = volume_.values();
   std::fill(cell_stabilization_.begin(), cell_stabilization_.end(), 0.0);
+  std::vector<double> fill(cell_stabilization_.size(), 0.0);
   const auto G = shear_modulus_.bound() ? shear_modulus_.values() : std::span<const double>{};
   const double tau = params_.real("stabilization");
   for (std::size_t q = 0; q < vol.size(); ++q) {
@@ -312,7 +322,12 @@ void HydraulicPhysics::update_cell_stabilization() {
       stride *= static_cast<std::size_t>(grid.cells[d]);
     }
     cell_stabilization_[c] += weight;
+    fill[c] += vol[q];
   }
+  double cell_volume = 1;
+  for (int d = 0; d < kDim; ++d) cell_volume *= grid.spacing[d];
+  for (std::size_t c = 0; c < fill.size(); ++c)
+    if (fill[c] < kProjectionMinimumFill * cell_volume) cell_stabilization_[c] = 0;
   stabilization_version_ = kernel_->transfer().version();
 }
 
@@ -347,6 +362,7 @@ void HydraulicPhysics::solve_pressure() {
   const auto start = std::chrono::steady_clock::now();
   const SolveStats stats = system_->solve(rhs_, *dp_, update);
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  preconditioner_seconds_ += stats.setup_seconds;
   ++solves_;
   step_iterations_.push_back(stats.iterations);
   step_residuals_.push_back(stats.relative_residual);

@@ -296,14 +296,19 @@ struct SparseSystem::Impl {
       params.set("verbosity", "none");
       params.set("multigrid algorithm", "sa");
       params.set("coarse: max size", 200);
+      // Aggregates follow the strong couplings only (|a_ij| ≥ 0.02 √(a_ii a_jj)): across a
+      // permeability jump of orders of magnitude (frozen against thawed soil) an aggregate
+      // that straddles the jump interpolates the stiff side from the soft one. With it the 9 %
+      // frozen inclusion needs 12–15 CG iterations per step instead of 18–24 (0.04–0.01 m).
+      params.set("aggregation: drop tol", 0.02);
       // Symmetric smoothing keeps the V-cycle symmetric, as CG needs.
       params.set("smoother: type", "RELAXATION");
       params.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
       params.sublist("smoother: params").set("relaxation: sweeps", 1);
-      // A relaxation coarse solve (not a direct solver) keeps this MPI- and build-agnostic.
-      params.set("coarse: type", "RELAXATION");
-      params.sublist("coarse: params").set("relaxation: type", "Symmetric Gauss-Seidel");
-      params.sublist("coarse: params").set("relaxation: sweeps", 4);
+      // The coarsest level (≤ 200 unknowns) solved exactly (KLU2 through Amesos2, which gathers
+      // a distributed coarse matrix itself): an inexact coarse solve lets the iteration count
+      // grow with refinement.
+      params.set("coarse: type", "KLU2");
       // A refresh keeps the aggregates and prolongators and recomputes the coarse operators and
       // smoothers from the new values (MueLu's "RP" reuse).
       params.set("reuse: type", "RP");
