@@ -1,5 +1,6 @@
 // Quantities with units through the whole program: a scene written with units runs as the same
-// scene in SI numbers to the last bit and resolves to the same values; `--set` takes units.
+// scene in SI numbers to the last bit and resolves to the same values; `--set` takes units; a run
+// ends with its summary paragraph.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -81,4 +82,25 @@ TEST_CASE("--set takes a value with a unit; the SI number is what check prints",
   CHECK(bad.exit_code == 2);
   CHECK(bad.output == "error: --set time.end=20 kPa: at 'time.end': '20 kPa' is not a time: its unit kPa is not "
                       "convertible to s\n");
+}
+
+TEST_CASE("a run ends with one paragraph: outputs, steps, times and the heat balance", "[units][cli]") {
+  TempDir dir;
+  const auto r = run_frostmpm("run " + source_dir() + "/" + kSi + " -o " + dir.file("out") + " --set time.end=1200");
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.output, Catch::Contains("frostmpm: task 'simulation' finished; results in " + dir.file("out") +
+                                       ": checkpoint.h5, fields.h5, fields.xdmf (open it in ParaView), metrics.csv, "
+                                       "run.json. 2 steps to t = 20 min (dt 10 min to 10 min) in "));
+  CHECK_THAT(r.output, Catch::Contains("; the heat balance closes to "));
+  CHECK(std::count(r.output.begin(), r.output.end(), '\n') == 1);  // one paragraph, one line
+}
+
+TEST_CASE("a task without steps ends with the paragraph too", "[units][cli]") {
+  TempDir dir;
+  const auto r = run_frostmpm("run " + source_dir() + "/configs/tutorials/freezing_curves.yaml -o " + dir.file("out"));
+  INFO(r.output);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.output, Catch::Contains("frostmpm: task 'freezing_curves' finished; results in " + dir.file("out") +
+                                       ": freezing_curves.csv, run.json. It ran in "));
 }

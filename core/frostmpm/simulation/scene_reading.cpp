@@ -148,7 +148,7 @@ ParamSchema output_schema() {
   s.real("every", "s", "simulated time between field frames (fields.h5); 0 = first and last only")
       .defaults_to(0.0).at_least(0);
   s.real("metrics_every", "s", "simulated time between metrics.csv rows; 0 = every step").defaults_to(0.0).at_least(0);
-  s.boolean("progress", "print a progress line with time, step, dt and ETA").defaults_to(true);
+  s.boolean("progress", "print a progress line every 2 s of wall time: simulated time (in s, min, h, d or yr) and its percentage of time.end, step, dt and ETA").defaults_to(true);
   return s;
 }
 

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "frostmpm/config/units.hpp"
 #include "frostmpm/io/log.hpp"
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/io/particle_field_reader.hpp"
@@ -37,6 +38,16 @@ constexpr const char* kProbeState = "_probes";
 constexpr const char* kDeformationGradient = "deformation_gradient";
 constexpr const char* kInitialVolume = "volume_initial";
 constexpr const char* kInitialHalfSize = "half_size_initial";
+
+/// "  t = 3.42 h of 50 h (6.8 %)  step 120  dt = 102 s  ETA 31 s": simulated times in the unit
+/// that reads best, the step in s (what time.dt and the stability limits speak of).
+std::string progress_line(double time, double end, long step, double dt, double eta_seconds) {
+  std::ostringstream line;
+  line << "  t = " << units::readable_duration(time) << " of " << units::readable_duration(end) << " ("
+       << std::fixed << std::setprecision(1) << 100.0 * time / end << " %)  step " << step << "  dt = "
+       << std::defaultfloat << std::setprecision(3) << dt << " s  ETA " << units::readable_duration(eta_seconds, 2);
+  return line.str();
+}
 
 double determinant3(const double* F) {
   return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
@@ -909,10 +920,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
       last_print = Clock::now();
       const double wall = std::chrono::duration<double>(last_print - wall_start).count();
       const double eta = wall * (end_time_ - time_) / std::max(time_ - time_start, 1e-300);
-      std::ostringstream line;
-      line << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
-           << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
-      log::info(line.str());
+      log::info(progress_line(time_, end_time_, step_, dt_, eta));
     }
     if (time_ >= end_time_ - eps) break;
 
