@@ -74,7 +74,7 @@ TEST_CASE("the resolved scene of a scene with units holds the SI numbers", "[uni
   CHECK(units["regions"][1]["initial"]["temperature"].as<double>() == -5.0);
 }
 
-TEST_CASE("--set takes a value with a unit; the SI number is what check prints", "[units][cli]") {
+TEST_CASE("a --set value may carry a unit, and check prints the SI number", "[units][cli]") {
   const YAML::Node scene = resolved(kSi, " --set 'time.end=90 d' --set 'probes.3.point=[50 cm, 0.5]'");
   CHECK(scene["time"]["end"].as<double>() == 7776000.0);
   CHECK(scene["probes"][3]["point"][0].as<double>() == 0.5);

@@ -112,7 +112,7 @@ TEST_CASE("wrong type for a real parameter", "[config]") {
       "    residual_saturation: 0.05\n";
   const std::string message = input_error_of([&] { read_sfcc(scene); });
   INFO(message);
-  CHECK(contains(message, "expected a number, got 'abc'"));
+  CHECK(contains(message, "expected a number (in K, or with its unit), got 'abc'"));
   CHECK(contains(message, "'material.sfcc.width'"));
   CHECK(contains(message, "scene.yaml:4:"));
 

@@ -48,7 +48,7 @@ std::string read_error(const std::string& value, const std::string& unit) {
 
 }  // namespace
 
-TEST_CASE("a number with a unit splits into value and unit; anything else does not", "[units]") {
+TEST_CASE("a number with a unit splits into value and unit, anything else does not", "[units]") {
   const auto q = units::split(" 2.1 W/(m K) ");
   REQUIRE(q);
   CHECK(q->value == 2.1);
