@@ -74,7 +74,11 @@ you do).* How the sections fit together is explained in [user-guide.md](user-gui
 A scene is a YAML mapping. `task:` chooses what `frostmpm run` does, and each task owns its
 top-level sections; `plugin_paths:` (a list of plugin folders or library files, relative to the scene
 file) is accepted by every task. Every key is checked: an unknown key is an error that names the
-closest valid one.
+closest valid one. A number may carry a unit (`end: 90 d`, `cell_size: 5 cm`, `width: 0.5 K`):
+the unit columns below say what a bare number is in, and a value with a unit is converted to it
+(UDUNITS-2 units; `-` is a pure number, which also takes `35 %`; `degC` an absolute
+temperature, which also takes `271.15 K`; `K` a temperature difference). See *Quantities with
+units* in [user-guide.md](user-guide.md).
 
 | task | sections |
 |---|---|

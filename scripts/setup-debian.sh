@@ -5,7 +5,7 @@ PKGS=(
   build-essential cmake ninja-build ccache pkg-config git
   libeigen3-dev libyaml-cpp-dev libboost-dev libboost-filesystem-dev libboost-system-dev
   trilinos-all-dev libptscotch-dev libhdf5-openmpi-dev libopenmpi-dev openmpi-bin
-  catch2 libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev
+  catch2 libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libudunits2-dev
   nlohmann-json3-dev python3-numpy python3-scipy python3-matplotlib python3-h5py
 )
 missing=()

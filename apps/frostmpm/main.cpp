@@ -22,6 +22,7 @@
 #include "frostmpm/simulation/interrupt.hpp"
 #include "frostmpm/simulation/simulation.hpp"
 #include "reference.hpp"
+#include "run_summary.hpp"
 #include "task.hpp"
 #include "test_model.hpp"
 
@@ -236,7 +237,7 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
     log::write(log::Level::warning, message.str());
     return 128 + interrupted->signal;
   }
-  log::info("frostmpm: task '" + prepared->task_name + "' finished; results in " + dir);
+  log::info(app::run_summary(summary, dir));
   return 0;
 }
 

@@ -36,7 +36,7 @@ class TemperatureElastic final : public frostmpm::MechanicalModel {
         .defaults_to(0.0)
         .at_least(-10)
         .at_most(10);
-    s.real("stiffening_range", "degC", "dT: the modulus reaches E_f at T_f - dT")
+    s.real("stiffening_range", "K", "dT: the modulus reaches E_f at T_f - dT")
         .defaults_to(10.0)
         .above(0)
         .at_most(100);

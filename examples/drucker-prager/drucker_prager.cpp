@@ -59,8 +59,8 @@ class DruckerPrager final : public frostmpm::MechanicalModel {
     s.real("poisson_ratio", "-", "Poisson's ratio ν (0 ≤ ν < 0.5)").at_least(0).below(0.5);
     s.real("cohesion", "Pa", "Mohr–Coulomb cohesion c (frozen soil: up to a few MPa)").at_least(0).at_most(1e7);
     // Below 80°: the cone stays well shaped (α < 0.86).
-    s.real("friction_angle", "deg", "Mohr–Coulomb friction angle φ").at_least(0).below(80);
-    s.real("dilation_angle", "deg", "Mohr–Coulomb dilation angle ψ ≤ φ (ψ = φ: associated flow; 0: no plastic volume change)")
+    s.real("friction_angle", "degree", "Mohr–Coulomb friction angle φ").at_least(0).below(80);
+    s.real("dilation_angle", "degree", "Mohr–Coulomb dilation angle ψ ≤ φ (ψ = φ: associated flow; 0: no plastic volume change)")
         .defaults_to(0.0)
         .at_least(0)
         .below(80);

@@ -15,7 +15,7 @@ class ExponentialDecaySfcc final : public frostmpm::SfccModel {
 
   static frostmpm::ParamSchema schema() {
     frostmpm::ParamSchema s;
-    s.real("decay_scale", "degC", "a: temperature scale of the decay").above(0);
+    s.real("decay_scale", "K", "a: temperature scale of the decay").above(0);
     s.real("residual_saturation", "-", "S_res far below freezing").defaults_to(0.0).at_least(0).below(1);
     s.real("freezing_point", "degC", "T_f").defaults_to(0.0);
     return s;

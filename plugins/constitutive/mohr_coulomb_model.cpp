@@ -27,8 +27,8 @@ void MohrCoulombModel::declare(ParamSchema& s, bool ice) {
   s.real("cohesion", "Pa", "peak cohesion c′_p of the unfrozen soil").at_least(0).at_most(1e10);
   // Below 80°: no soil comes near, and as φ → 90° the cone degenerates (1 − sin φ → 0) and the
   // return loses its accuracy.
-  s.real("friction_angle", "deg", "peak friction angle φ′_p of the unfrozen soil").at_least(0).below(kMaxFriction);
-  s.real("dilation_angle", "deg", "peak dilation angle ψ′_p (at most φ′_p; 0: plastic flow keeps the volume)")
+  s.real("friction_angle", "degree", "peak friction angle φ′_p of the unfrozen soil").at_least(0).below(kMaxFriction);
+  s.real("dilation_angle", "degree", "peak dilation angle ψ′_p (at most φ′_p; 0: plastic flow keeps the volume)")
       .defaults_to(0.0)
       .at_least(0)
       .below(90);
@@ -36,11 +36,11 @@ void MohrCoulombModel::declare(ParamSchema& s, bool ice) {
       .at_least(0)
       .at_most(1e10)
       .optional("the peak cohesion");
-  s.real("residual_friction_angle", "deg", "residual friction angle φ′_res (Eq. 35)")
+  s.real("residual_friction_angle", "degree", "residual friction angle φ′_res (Eq. 35)")
       .at_least(0)
       .below(kMaxFriction)
       .optional("the peak friction angle");
-  s.real("residual_dilation_angle", "deg", "residual dilation angle ψ′_res (Eq. 35)")
+  s.real("residual_dilation_angle", "degree", "residual dilation angle ψ′_res (Eq. 35)")
       .at_least(0)
       .below(90)
       .optional("the peak dilation angle");
@@ -57,11 +57,11 @@ void MohrCoulombModel::declare(ParamSchema& s, bool ice) {
       .optional("c cot φ, the apex of the cone");
   if (!ice) return;
   s.real("max_ice_cohesion", "Pa", "Δc_max of Eq. 36: the cohesion ice bonding adds at most").at_least(0).at_most(1e10);
-  s.real("max_ice_friction_angle", "deg", "Δφ_max of Eq. 36: the friction angle ice bonding adds at most")
+  s.real("max_ice_friction_angle", "degree", "Δφ_max of Eq. 36: the friction angle ice bonding adds at most")
       .defaults_to(0.0)
       .at_least(0)
       .below(kMaxFriction);
-  s.real("max_ice_dilation_angle", "deg", "Δψ_max: the dilation angle ice bonding adds at most (at most Δφ_max)")
+  s.real("max_ice_dilation_angle", "degree", "Δψ_max: the dilation angle ice bonding adds at most (at most Δφ_max)")
       .defaults_to(0.0)
       .at_least(0)
       .below(90);

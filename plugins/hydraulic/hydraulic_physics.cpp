@@ -71,8 +71,8 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   gravity_ = sim.gravity();
   mass_scaling_ = sim.time_params().real("mass_scaling");
   transport_scaling_ = sim.time_params().real("transport_scaling");
-  sim.declare_state_field("porosity", 1, 0.0);
-  sim.declare_state_field("pore_pressure", 1, 0.0, /*max_magnitude Pa=*/1e10);
+  sim.declare_state_field("porosity", 1, 0.0, "-");
+  sim.declare_state_field("pore_pressure", 1, 0.0, "Pa", /*max_magnitude=*/1e10);
   sim.declare_field("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
   sim.declare_field("liquid_velocity", kDim, 0.0, FieldKind::Vector);
   sim.declare_field("water_flux", kDim, 0.0, FieldKind::Vector);
@@ -128,8 +128,9 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
     if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
     PressureCondition c;
     c.nodes = bc->nodes;
-    c.value = TimeFunction::read(bc->node->child("value"), kMaxPressure, end);
     if (auto h = bc->node->optional_child("hydrostatic")) c.hydrostatic = h->as_bool();
+    // Hydrostatic: the value is the water table's elevation.
+    c.value = TimeFunction::read(bc->node->child("value"), c.hydrostatic ? "m" : "Pa", kMaxPressure, end);
     c.label = bc->label();
     pressure_bcs_.push_back(std::move(c));
   }
@@ -139,7 +140,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
                       std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
     if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");
     flux_bcs_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxWaterFlux, end), bc->label()});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), "m/s", kMaxWaterFlux, end), bc->label()});
   }
 }
 

@@ -130,7 +130,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     bool any = false;
     for (int d = 0; d < Dim; ++d)
       if (auto v = bc->node->optional_child(axis_name(d))) {
-        value[d] = TimeFunction::read(*v, kMaxVelocity, end);
+        value[d] = TimeFunction::read(*v, "m/s", kMaxVelocity, end);
         any = true;
       }
     if (!any)
@@ -147,7 +147,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     c.nodes = bc->nodes;
     c.axis = bc->face_axis;
     c.side = bc->face_side;
-    c.load = TimeFunction::read(bc->node->child("force"), 1e12, end);
+    c.load = TimeFunction::read(bc->node->child("force"), "N/m", 1e12, end);
     for (std::size_t i : c.nodes) {
       int& owner = constraint_owner_[i * Dim + c.axis];
       if (owner != kFree) {
@@ -208,17 +208,17 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
                             join(axis_keys<Dim>(), ":, ") + ": (Pa, tension positive)");
     if (by_components) {
       for (int d = 0; d < Dim; ++d)
-        if (auto t = bc->node->optional_child(axis_name(d))) value[d] = TimeFunction::read(*t, kMaxTraction, end);
+        if (auto t = bc->node->optional_child(axis_name(d))) value[d] = TimeFunction::read(*t, "Pa", kMaxTraction, end);
     } else {
       if (bc->face_axis < 0) throw bc->node->error("normal: and shear: need a face target: nodes: {face: ...}");
       if (auto t = bc->node->optional_child("normal")) {
         // Along the outward normal: +axis on a max face, −axis on a min face.
-        const TimeFunction f = TimeFunction::read(*t, kMaxTraction, end);
+        const TimeFunction f = TimeFunction::read(*t, "Pa", kMaxTraction, end);
         value[bc->face_axis] = bc->face_side > 0 ? f : f.scaled(-1.0);
       }
       if (auto t = bc->node->optional_child("shear")) {
         if (Dim != 2) throw t->error("shear: is a 2-D key; in 3-D give the traction by components x:, y:, z:");
-        value[1 - bc->face_axis] = TimeFunction::read(*t, kMaxTraction, end);
+        value[1 - bc->face_axis] = TimeFunction::read(*t, "Pa", kMaxTraction, end);
       }
     }
     add_traction(bc, std::move(value));
@@ -228,11 +228,11 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     int axis = bc->face_axis, side = bc->face_side;
     if (bc->on_particles) {
       axis = particle_normal_axis(*bc);
-      side = bc->node->child("normal").as_reals()[std::size_t(axis)] > 0 ? 1 : -1;
+      side = bc->node->child("normal").as_reals("-")[std::size_t(axis)] > 0 ? 1 : -1;
     } else if (axis < 0) {
       throw bc->node->error("surcharge acts on a grid face (nodes: {face: ...}) or on particles with an outward normal:");
     }
-    const TimeFunction q = TimeFunction::read(bc->node->child("value"), kMaxTraction, end);
+    const TimeFunction q = TimeFunction::read(bc->node->child("value"), "Pa", kMaxTraction, end);
     std::array<TimeFunction, Dim> value;
     // A pressure pushes into the material: against the outward normal.
     value[axis] = side > 0 ? q.scaled(-1.0) : q;
@@ -250,14 +250,14 @@ void MechanicalPhysics<Dim>::read_footing(BoundaryCondition& bc, const Kernel<Di
   const double end = kernel.end_time(), h = grid.min_spacing();
   FootingCondition f;
   const ConfigNode box = bc.node->child("nodes").child("box");
-  const auto lo = box.child("min").as_reals(), hi = box.child("max").as_reals();
+  const auto lo = box.child("min").as_reals("m"), hi = box.child("max").as_reals("m");
   for (int d = 0; d < Dim; ++d) f.lo[d] = lo.at(std::size_t(d)), f.hi[d] = hi.at(std::size_t(d));
 
   std::array<std::optional<TimeFunction>, Dim> value;
   int given = 0;
   for (int d = 0; d < Dim; ++d)
     if (auto v = bc.node->optional_child(axis_name(d))) {
-      value[d] = TimeFunction::read(*v, kMaxVelocity, end);
+      value[d] = TimeFunction::read(*v, "m/s", kMaxVelocity, end);
       f.axis = d;
       ++given;
     }
@@ -369,7 +369,7 @@ std::optional<Physics::RigidBodyMotion> MechanicalPhysics<Dim>::rigid_body(const
 template <int Dim>
 int MechanicalPhysics<Dim>::particle_normal_axis(const BoundaryCondition& bc) {
   const ConfigNode n = bc.node->child("normal");
-  const auto v = n.as_reals();
+  const auto v = n.as_reals("-");
   int axis = -1, count = 0;
   for (std::size_t d = 0; d < v.size(); ++d)
     if (v[d] != 0) axis = int(d), ++count;

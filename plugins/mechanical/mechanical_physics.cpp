@@ -191,8 +191,8 @@ template <int Dim>
 void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   kernel_ = &kernel;
   mass_scaling_ = kernel.time_params().real("mass_scaling");
-  kernel.declare_state_field("porosity", 1, 0.0);
-  kernel.declare_state_field("solid_velocity", Dim, 0.0, /*max_magnitude m/s=*/1e4, FieldKind::Vector);
+  kernel.declare_state_field("porosity", 1, 0.0, "-");
+  kernel.declare_state_field("solid_velocity", Dim, 0.0, "m/s", /*max_magnitude=*/1e4, FieldKind::Vector);
   kernel.declare_field("displacement", Dim, 0.0, FieldKind::Vector);
   kernel.declare_history("stress", 6, 0.0, FieldKind::SymmetricTensor);
   kernel.declare_field("strain", 6, 0.0, FieldKind::SymmetricTensor);

@@ -16,7 +16,7 @@ class ExponentialSfcc final : public SfccModel {
 
   static ParamSchema schema() {
     ParamSchema s;
-    s.real("width", "degC", "width W (the paper's M) of the freezing interval").above(0).at_most(100);
+    s.real("width", "K", "width W (the paper's M) of the freezing interval").above(0).at_most(100);
     s.real("residual_saturation", "-", "S_res, liquid saturation far below freezing").at_least(0).below(1);
     s.real("freezing_point", "degC", "T_f, fully thawed at and above").defaults_to(0.0).at_least(-273.15).at_most(100);
     return s;

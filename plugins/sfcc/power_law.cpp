@@ -17,7 +17,7 @@ class PowerLawSfcc final : public SfccModel {
   static ParamSchema schema() {
     ParamSchema s;
     s.real("exponent", "-", "power b (> 0); larger drops faster").above(0).at_most(100);
-    s.real("reference_depression", "degC", "T_ref: freezing starts at T_f - T_ref").above(0).at_most(273.15);
+    s.real("reference_depression", "K", "T_ref: freezing starts at T_f - T_ref").above(0).at_most(273.15);
     s.real("residual_saturation", "-", "S_res lower bound").defaults_to(0.0).at_least(0).below(1);
     s.real("freezing_point", "degC", "T_f").defaults_to(0.0).at_least(-273.15).at_most(100);
     return s;

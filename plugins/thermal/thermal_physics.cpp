@@ -36,7 +36,7 @@ ParamSchema ThermalPhysics::schema() {
       .defaults_to(0.9)
       .above(0)
       .at_most(1);
-  s.real("nonlinear_tolerance", "degC",
+  s.real("nonlinear_tolerance", "K",
          "implicit: Newton stops when every node's energy residual is worth less than this much "
          "sensible heat")
       .defaults_to(1e-6).above(0);
@@ -66,8 +66,8 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
 void ThermalPhysics::setup(Kernel<kDim>& sim) {
   kernel_ = &sim;
   transport_scaling_ = sim.time_params().real("transport_scaling");
-  sim.declare_state_field("temperature", 1, 0.0, /*max_magnitude degC=*/1e4);
-  sim.declare_state_field("porosity", 1, 0.0);
+  sim.declare_state_field("temperature", 1, 0.0, "degC", /*max_magnitude=*/1e4);
+  sim.declare_state_field("porosity", 1, 0.0, "-");
   sim.declare_field("temperature_pic", 1);
   sim.declare_field("liquid_saturation", 1, 1.0);
   sim.declare_field("heat_deviation", 1, 0.0);
@@ -128,7 +128,7 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
     bc->accept_keys({"value"});
-    TimeFunction value = TimeFunction::read(bc->node->child("value"), kMaxTemperature, end);
+    TimeFunction value = TimeFunction::read(bc->node->child("value"), "degC", kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
   }
@@ -138,7 +138,7 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
   auto surface = [&](const BoundaryCondition* bc, std::vector<NodeCondition>& list) {
     if (bc->on_particles) {
       const ConfigNode area = bc->node->child("area");
-      const double value = area.as_real();
+      const double value = area.as_real("m^2");
       if (!(value > 0) || value > 1e6)
         throw area.error("the surface the particles stand for must be positive (m², per m in 2-D), got " + area.as_string());
       particle_surfaces_.push_back({bc->particles, value, &list, list.size()});
@@ -152,16 +152,16 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
     bc->accept_keys({"value", "area"});
     surface(bc, flux_);
     flux_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), kMaxHeatFlux, end), 0.0, bc->label()});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), "W/m^2", kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
     bc->accept_keys({"h", "ambient", "area"});
     surface(bc, convective_);
     const ConfigNode h = bc->node->child("h");
-    const double coefficient = h.as_real();
+    const double coefficient = h.as_real("W/(m^2 K)");
     if (!(coefficient > 0)) throw h.error("heat transfer coefficient h must be positive (W/m^2/K)");
     convective_.push_back(
-        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), kMaxTemperature, end), coefficient, bc->label()});
+        {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("ambient"), "degC", kMaxTemperature, end), coefficient, bc->label()});
   }
 }
 

@@ -281,7 +281,7 @@ TEST_CASE("bad checkpoint values are one error line naming the YAML path, exit 2
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"{every_steps: -1}", "at 'checkpoint.every_steps'"},
       {"{every_steps: 2.5}", "at 'checkpoint.every_steps'"},
-      {"{every_minutes: soon}", "expected a number, got 'soon'"},
+      {"{every_minutes: soon}", "expected a number (in min, or with its unit), got 'soon'"},
       {"{every_minutes: -5}", "at 'checkpoint.every_minutes'"},
       {"{every_step: 5}", "did you mean 'every_steps'"}};
   for (const auto& [value, expected] : cases) {
@@ -321,7 +321,7 @@ class MemoryPhysics final : public Physics {
   std::vector<std::string> boundary_types() const override { return {}; }
   void setup(Kernel<2>& sim) override {
     sim_ = &sim;
-    sim.declare_state_field(field(), 1, 0.0);
+    sim.declare_state_field(field(), 1, 0.0, "-");
     nodal_.assign(sim.grid().node_count(), 0.0);
   }
   std::vector<Stage> stages() override {

@@ -53,6 +53,8 @@ TEST_CASE("plugins lists good plugins and every refused library with its reason,
   CHECK(has(bad_default, "sfcc model 'bad_default'"));
   CHECK(has(bad_default, "default 1 of parameter 'residual_saturation' is outside its own range [0, 1)"));
   CHECK(!has(r.output, "bad_default  "));  // nothing of a refused library stays registered
+  const std::string bad_unit = line_with(r.output, "libfixture_bad_unit.so");
+  CHECK(has(bad_unit, "sfcc model 'bad_unit': parameter 'width' declares the unit 'celsiuz'"));
   CHECK(has(line_with(r.output, "libfixture_not_a_plugin.so"), "not a FrostMPM plugin"));
 }
 

@@ -100,7 +100,7 @@ TEST_CASE("missing required parameter is named with its section", "[config]") {
   CHECK(contains(message, "missing required parameter 'width'"));
   CHECK(contains(message, "'material.sfcc'"));
   CHECK(contains(message, "scene.yaml:3:"));  // where the section's mapping starts
-  CHECK(contains(message, "degC"));           // the unit helps the user
+  CHECK(contains(message, "interval, K)"));   // the unit helps the user
 }
 
 TEST_CASE("wrong type for a real parameter", "[config]") {
@@ -112,7 +112,7 @@ TEST_CASE("wrong type for a real parameter", "[config]") {
       "    residual_saturation: 0.05\n";
   const std::string message = input_error_of([&] { read_sfcc(scene); });
   INFO(message);
-  CHECK(contains(message, "expected a number, got 'abc'"));
+  CHECK(contains(message, "expected a number (in K, or with its unit), got 'abc'"));
   CHECK(contains(message, "'material.sfcc.width'"));
   CHECK(contains(message, "scene.yaml:4:"));
 

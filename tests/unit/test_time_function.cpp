@@ -25,7 +25,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 /// Reads `top.temperature: <value_yaml>` from a scene text (the value starts on line 2).
 TimeFunction read_tf(const std::string& value_yaml) {
   const auto root = ConfigNode::load_string("top:\n  temperature: " + value_yaml + "\n", "scene.yaml");
-  return TimeFunction::read(root.child("top").child("temperature"));
+  return TimeFunction::read(root.child("top").child("temperature"), "degC");
 }
 
 /// Message of the InputError thrown by reading `value_yaml`; fails the test if none is thrown.
@@ -163,7 +163,7 @@ TEST_CASE("table input errors name the path, the line and the row", "[timefuncti
     const auto root = ConfigNode::load_string(
         "top:\n  temperature:\n    table:\n      - [0, 1]\n      - [10, 2]\n      - [10, 3]\n", "scene.yaml");
     try {
-      TimeFunction::read(root.child("top").child("temperature"));
+      TimeFunction::read(root.child("top").child("temperature"), "degC");
       FAIL("expected an InputError");
     } catch (const InputError& e) {
       REQUIRE(contains(e.what(), "scene.yaml:6"));

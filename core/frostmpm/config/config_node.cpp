@@ -12,6 +12,8 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/parser.h>
 
+#include "frostmpm/config/units.hpp"
+
 namespace frostmpm {
 
 namespace {
@@ -252,12 +254,30 @@ namespace {
 std::string scalar_text(const YAML::Node& n) { return n.IsScalar() ? n.Scalar() : std::string("<non-scalar>"); }
 }  // namespace
 
-double ConfigNode::as_real() const {
+double ConfigNode::as_real(const std::string& unit) const {
   if (!node_.IsScalar()) throw error("expected a number");
+  const std::string text = scalar_text(node_);
   double value = 0;
-  if (!YAML::convert<double>::decode(node_, value))
-    throw error("expected a number, got '" + scalar_text(node_) + "'");
-  if (!std::isfinite(value)) throw error("expected a finite number, got '" + scalar_text(node_) + "'");
+  if (YAML::convert<double>::decode(node_, value)) {
+    if (!std::isfinite(value)) throw error("expected a finite number, got '" + text + "'");
+    return value;
+  }
+  const auto quantity = units::split(text);
+  if (!quantity)
+    throw error("expected a number" + std::string(unit.empty() || unit == "-" ? "" : " (in " + unit + ", or with its unit)") +
+                ", got '" + text + "'");
+  try {
+    value = units::convert(*quantity, unit);
+  } catch (const units::UnitError& e) {
+    throw error(e.what());
+  }
+  if (!std::isfinite(value)) throw error("expected a finite number, got '" + text + "'");
+  // The tree now says what was read: the number in the declared unit. A string assignment keeps
+  // the node's mark (its line in messages); the tag of a quoted scalar ("90 d") would keep the
+  // number a string in run.json.
+  YAML::Node in_tree = node_;
+  in_tree = YAML::Node(value).Scalar();
+  in_tree.SetTag("?");
   return value;
 }
 
@@ -265,7 +285,8 @@ long ConfigNode::as_integer() const {
   if (!node_.IsScalar()) throw error("expected an integer");
   long value = 0;
   if (!YAML::convert<long>::decode(node_, value))
-    throw error("expected an integer, got '" + scalar_text(node_) + "'");
+    throw error("expected an integer, got '" + scalar_text(node_) + "'" +
+                (units::split(scalar_text(node_)) ? " (a count takes no unit)" : ""));
   return value;
 }
 
@@ -281,10 +302,18 @@ std::string ConfigNode::as_string() const {
   return node_.Scalar();
 }
 
-std::vector<double> ConfigNode::as_reals() const {
-  if (node_.IsScalar()) return {as_real()};
+std::vector<double> ConfigNode::as_reals(const std::string& unit) const {
+  if (node_.IsScalar()) return {as_real(unit)};
   std::vector<double> out;
-  for (const auto& e : elements()) out.push_back(e.as_real());
+  for (const auto& e : elements()) out.push_back(e.as_real(unit));
+  return out;
+}
+
+std::vector<double> ConfigNode::as_row(const std::vector<std::string>& units, const std::string& what) const {
+  if (!node_.IsSequence() || node_.size() != units.size()) throw error("expected " + what);
+  std::vector<double> out;
+  const auto items = elements();
+  for (std::size_t i = 0; i < units.size(); ++i) out.push_back(items[i].as_real(units[i]));
   return out;
 }
 

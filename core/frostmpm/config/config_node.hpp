@@ -54,11 +54,20 @@ class ConfigNode {
   std::vector<ConfigNode> elements() const;
 
   // ---- scalars ----
-  double as_real() const;
+  /// A number in `unit` (a UDUNITS-2 unit, "-" for a pure number, "" for a bare number only;
+  /// see units.hpp). A bare number is taken as given, in `unit`; "<number> <unit>" ("90 d",
+  /// "-2 degC") is converted to `unit`, and then replaced in the scene tree by that number, so
+  /// that what copies the tree afterwards (the resolved scene of `check` and run.json) holds the
+  /// declared unit's numbers.
+  double as_real(const std::string& unit) const;
   long as_integer() const;
   bool as_bool() const;
   std::string as_string() const;
-  std::vector<double> as_reals() const;
+  /// One number or a list of numbers, each as_real(unit).
+  std::vector<double> as_reals(const std::string& unit) const;
+  /// A list of exactly `units.size()` numbers, element i in units[i] (a table row [time, value]);
+  /// `what` names the row in the error about its length ("a row [time, value]").
+  std::vector<double> as_row(const std::vector<std::string>& units, const std::string& what) const;
 
   const YAML::Node& raw() const { return node_; }
 

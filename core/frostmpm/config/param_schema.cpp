@@ -211,7 +211,7 @@ void check_range(const ParamSpec& spec, double v, const ConfigNode& node) {
 ParamValue read_value(const ParamSpec& spec, const ConfigNode& node) {
   switch (spec.type) {
     case ParamType::Real: {
-      const double v = node.as_real();
+      const double v = node.as_real(spec.unit);
       check_range(spec, v, node);
       return v;
     }
@@ -230,7 +230,7 @@ ParamValue read_value(const ParamSpec& spec, const ConfigNode& node) {
                        " Valid: " + join(spec.choices));
     }
     case ParamType::RealList: {
-      std::vector<double> v = node.as_reals();
+      std::vector<double> v = node.as_reals(spec.unit);
       if (spec.list_size && v.size() != spec.list_size)
         throw node.error("expected a list of " + std::to_string(spec.list_size) + " numbers, got " +
                          std::to_string(v.size()));

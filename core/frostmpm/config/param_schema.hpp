@@ -22,7 +22,9 @@ using ParamValue = std::variant<double, long, bool, std::string, std::vector<dou
 struct ParamSpec {
   std::string name;
   ParamType type = ParamType::Real;
-  std::string unit;  ///< "" for dimensionless or not numeric
+  /// Of a Real or RealList: a UDUNITS-2 unit (absolute temperatures "degC", differences "K"),
+  /// "-" for a pure number; values given with another unit are converted to it (units.hpp).
+  std::string unit;
   std::string doc;
   std::optional<ParamValue> default_value;  ///< empty: required (unless optional_meaning is set)
   /// Set by optional(): the parameter may be left out and then has no value at all (ParamSet::has

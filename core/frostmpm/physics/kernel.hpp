@@ -90,10 +90,11 @@ class Kernel {
   /// Contiguous runs of particles of one material (one per region): models are evaluated in
   /// batches over these, one virtual call per range.
   virtual const std::vector<ParticleRange>& particle_ranges() const = 0;
-  /// A particle field that regions may initialise with `initial: {name: value}`; an initial
-  /// value of larger magnitude than `max_magnitude` is refused as a typo.
+  /// A particle field that regions may initialise with `initial: {name: value}`, in `unit` (a
+  /// UDUNITS-2 unit: "degC", "Pa", "m/s", "-"; a value given with another unit is converted);
+  /// an initial value of larger magnitude than `max_magnitude` is refused as a typo.
   virtual void declare_state_field(const std::string& name, int components, double default_value,
-                                   double max_magnitude = std::numeric_limits<double>::infinity(),
+                                   const std::string& unit, double max_magnitude = std::numeric_limits<double>::infinity(),
                                    FieldKind kind = FieldKind::Other) = 0;
   /// A particle field the physics keeps (not set by regions).
   virtual void declare_field(const std::string& name, int components, double initial = 0.0,

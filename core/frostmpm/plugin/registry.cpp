@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "frostmpm/config/units.hpp"
+
 namespace frostmpm {
 
 void Registry::add(RegistryEntry entry) {
@@ -62,7 +64,14 @@ std::vector<const RegistryEntry*> Registry::entries(const std::string& kind) con
 }
 
 void Registrar::add_entry(RegistryEntry entry) {
-  entry.schema.check_defaults(entry.kind + " model '" + entry.name + "'");
+  const std::string owner = entry.kind + " model '" + entry.name + "'";
+  entry.schema.check_defaults(owner);
+  // A unit UDUNITS-2 cannot read would fail only once a scene gave that parameter a unit.
+  for (const auto& spec : entry.schema.params())
+    if (!units::is_declarable(spec.unit))
+      throw InputError(owner + ": parameter '" + spec.name + "' declares the unit '" + spec.unit +
+                       "', which UDUNITS-2 does not read; declare one it does (m, Pa, W/(m K), degC for an absolute "
+                       "temperature, K for a difference) or '-' for a pure number");
   entry.library = library_;
   entry.plugin = plugin_;
   entry.version = version_;

@@ -6,12 +6,12 @@ namespace frostmpm {
 
 namespace {
 std::array<double, 2> read_point(const ConfigNode& node) {
-  const auto v = node.as_reals();
+  const auto v = node.as_reals("m");
   if (v.size() != 2) throw node.error("expected a point [x, y]");
   return {v[0], v[1]};
 }
 double read_positive(const ConfigNode& node) {
-  const double v = node.as_real();
+  const double v = node.as_real("m");
   if (!(v > 0)) throw node.error("must be positive");
   return v;
 }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <functional>
 
+#include "frostmpm/config/units.hpp"
+
 namespace frostmpm {
 
 struct TimeFunction::Impl {
@@ -96,28 +98,29 @@ TimeFunction TimeFunction::expression(const std::string& text) {
   return f;
 }
 
-TimeFunction TimeFunction::read(const ConfigNode& node, double max_magnitude, double end_time) {
-  const TimeFunction f = read(node);
+TimeFunction TimeFunction::read(const ConfigNode& node, const std::string& unit, double max_magnitude,
+                                double end_time) {
+  const TimeFunction f = read(node, unit);
   constexpr int kSamples = 16;
   for (int i = 0; i <= kSamples; ++i) {
     const double t = end_time * i / kSamples;
     const double v = f(t);
     if (!std::isfinite(v) || std::abs(v) > max_magnitude)
       throw node.error("the value at t = " + number_text(t) + " s is " + number_text(v) +
-                       (std::isfinite(v) ? ", beyond the plausible magnitude " + number_text(max_magnitude)
+                       (std::isfinite(v) ? " " + unit + ", beyond the plausible magnitude " + number_text(max_magnitude)
                                          : std::string(", not a finite number")));
     if (f.is_constant()) break;
   }
   return f;
 }
 
-TimeFunction TimeFunction::read(const ConfigNode& node) {
+TimeFunction TimeFunction::read(const ConfigNode& node, const std::string& unit) {
   if (node.is_scalar()) {
     const std::string text = node.as_string();
     double v = 0;
-    if (!YAML::convert<double>::decode(node.raw(), v))
+    if (!YAML::convert<double>::decode(node.raw(), v) && !units::split(text))
       throw node.error("expected a time function, got '" + text + "'; " + forms_help());
-    return constant(node.as_real());  // as_real rejects inf and nan
+    return constant(node.as_real(unit));  // as_real rejects inf and nan
   }
   if (!node.is_map()) throw node.error("expected a time function; " + forms_help());
 
@@ -162,10 +165,8 @@ TimeFunction TimeFunction::read(const ConfigNode& node) {
     std::vector<double> times, values;
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const ConfigNode& row = rows[i];
-      if (!row.is_sequence() || row.raw().size() != 2)
-        throw row.error("table row " + std::to_string(i) + " must be a pair [time, value]");
-      const std::vector<ConfigNode> pair = row.elements();
-      const double t = pair[0].as_real(), v = pair[1].as_real();
+      const auto pair = row.as_row({"s", unit}, "table row " + std::to_string(i) + " to be a pair [time, value]");
+      const double t = pair[0], v = pair[1];
       if (i > 0 && !(t > times.back()))
         throw row.error("table times must be strictly increasing: row " + std::to_string(i) + " (t = " +
                         number_text(t) + ") does not come after row " + std::to_string(i - 1) +

@@ -1,11 +1,13 @@
 #pragma once
 // A scalar function of time t (seconds) for boundary conditions and sources. In a scene it is
 // one of
-//   5.0                                              a constant
-//   {table: [[t0, v0], [t1, v1], ...],               piecewise, times strictly increasing;
+//   5.0                                              a constant ("20 kPa": with a unit, units.hpp)
+//   {table: [[t0, v0], [t1, v1], ...],               piecewise, times strictly increasing
+//                                                    (each number may carry a unit: [30 d, 5 degC]);
 //    interpolation: linear | step,                   (default linear; step holds v_i on [t_i, t_i+1))
 //    extrapolation: hold | error}                    (default hold: end values outside the table)
-//   {expression: "5 + 2*sin(2*pi*t/86400)"}          see expression.hpp for the syntax
+//   {expression: "5 + 2*sin(2*pi*t/86400)"}          see expression.hpp; t in s, the value in the
+//                                                    declared unit (an expression has no units)
 // It is read and checked once; evaluation is cheap and allocation-free, and copies share one
 // immutable implementation (safe to evaluate from several threads).
 #include <memory>
@@ -36,13 +38,14 @@ class TimeFunction {
   /// An expression of t from code; throws ExpressionError when malformed.
   static TimeFunction expression(const std::string& text);
 
-  /// Reads any of the three forms; consumes the node's keys and calls finish(). Every problem
-  /// is an InputError naming the YAML path and line.
-  static TimeFunction read(const ConfigNode& node);
+  /// Reads any of the three forms, values in `unit` (a UDUNITS-2 unit, units.hpp) and times in
+  /// s; consumes the node's keys and calls finish(). Every problem is an InputError naming the
+  /// YAML path and line.
+  static TimeFunction read(const ConfigNode& node, const std::string& unit);
   /// read(), then evaluated at setup at t = 0, `end_time` and points between: a value that is
   /// not finite (1/t, log(0)) or whose magnitude exceeds `max_magnitude` (in the quantity's
   /// unit) is an InputError naming the node, instead of a blow-up during the run.
-  static TimeFunction read(const ConfigNode& node, double max_magnitude, double end_time);
+  static TimeFunction read(const ConfigNode& node, const std::string& unit, double max_magnitude, double end_time);
 
   /// Value at time t. With `extrapolation: error`, a t outside the table is an InputError
   /// pointing at the table in the scene.

@@ -13,7 +13,7 @@ namespace frostmpm {
 namespace {
 
 std::array<double, Probes::kDim> read_point(const ConfigNode& node) {
-  const auto v = node.as_reals();
+  const auto v = node.as_reals("m");
   if (v.size() != Probes::kDim)
     throw node.error("expected a point with " + std::to_string(Probes::kDim) + " coordinates");
   return {v[0], v[1]};
@@ -149,7 +149,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
     if (probe->type == "integral") {
       for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
       if (auto scale = item.optional_child("scale")) {
-        probe->value = scale->as_real();
+        probe->value = scale->as_real("-");
         if (!std::isfinite(probe->value)) throw scale->error("scale must be a finite number");
       } else {
         probe->value = 1.0;
@@ -173,7 +173,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
     } else if (probe->type == "settlement") {
       double x_lo = -std::numeric_limits<double>::infinity(), x_hi = std::numeric_limits<double>::infinity();
       if (auto range = item.optional_child("x_range")) {
-        const auto r = range->as_reals();
+        const auto r = range->as_reals("m");
         if (r.size() != 2 || !(r[0] < r[1])) throw range->error("expected [x_min, x_max] with x_min < x_max");
         x_lo = r[0];
         x_hi = r[1];
@@ -230,7 +230,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       probe->field = "liquid_saturation";
       probe->value = 0.5;
       if (auto level = item.optional_child("saturation")) {
-        probe->value = level->as_real();
+        probe->value = level->as_real("-");
         if (!(probe->value > 0 && probe->value < 1))
           throw level->error("the liquid saturation that separates thawed from frozen must lie in (0, 1)");
       }
@@ -244,7 +244,8 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         probe->point = read_inside(item.child("point"));
         item.finish({"type", "name", "over_time", "field", "point"});
       } else if (probe->type == "isotherm") {
-        probe->value = item.child("value").as_real();
+        const auto unit = sources_.field_units.find(probe->field);
+        probe->value = item.child("value").as_real(unit == sources_.field_units.end() ? "" : unit->second);
         probe->from = read_inside(item.child("from"));
         probe->to = read_inside(item.child("to"));
         item.finish({"type", "name", "over_time", "field", "value", "from", "to"});

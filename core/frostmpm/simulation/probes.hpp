@@ -21,6 +21,7 @@
 //   footing_displacement  how far the footing has moved along its direction of motion, m
 #include <array>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -55,6 +56,9 @@ class Probes {
     std::vector<std::string> reaction_types;  ///< types of the scene's conditions that have a reaction
     std::function<std::array<double, 3>(const std::string&)> reaction;
     std::function<Physics::RigidBodyMotion(const std::string&)> rigid_body;
+    /// The unit of fields whose values a scene may give (an isotherm's value); other fields
+    /// take bare numbers.
+    std::map<std::string, std::string> field_units;
   };
 
   Probes();

@@ -14,7 +14,7 @@ namespace frostmpm {
 namespace {
 
 std::array<double, kDim> read_point(const ConfigNode& node) {
-  const auto v = node.as_reals();
+  const auto v = node.as_reals("m");
   if (v.size() != kDim) throw node.error("expected a point with " + std::to_string(kDim) + " coordinates");
   return {v[0], v[1]};
 }
@@ -93,14 +93,8 @@ void share_between_models(std::map<std::string, ModelSection>& models, const Con
     }
 }
 
-}  // namespace
-
-std::vector<std::string> Simulation::sections() {
-  return {"grid",    "time",       "gravity", "physics", "materials", "regions", "boundary_conditions",
-          "output", "probes", "checkpoint"};
-}
-
-void Simulation::read_grid(const ConfigNode& node) {
+/// The `grid:` section.
+ParamSchema grid_schema() {
   ParamSchema s;
   s.reals("origin", "m", "lower-left corner of the grid").size(kDim).defaults_to(std::vector<double>(kDim, 0.0));
   // At most 1e8 per axis: an int, and the 50-million-node cap below still applies.
@@ -119,7 +113,70 @@ void Simulation::read_grid(const ConfigNode& node) {
            "axes along which the grid wraps round (max face = min face), e.g. x for an infinite slope or "
            "layer; conditions on those faces are refused")
       .defaults_to("none");
-  const ParamSet p = parse_params(s, node);
+  return s;
+}
+
+/// The `time:` section.
+ParamSchema time_schema() {
+  ParamSchema s;
+  s.real("end", "s", "simulated end time").above(0);
+  s.real("dt", "s", "fixed time step; 0 = automatic from the physics' stability limits").defaults_to(0.0).at_least(0);
+  s.real("dt_max", "s", "upper bound on an automatic step; 0 = none").defaults_to(0.0).at_least(0);
+  s.integer("max_steps", "most steps, metrics rows or field frames a run may take; a scene needing more is refused")
+      .defaults_to(kDefaultMaxSteps).at_least(1);
+  s.real("mass_scaling", "-",
+         "factor on every inertia (skeleton and pore water; not on weight): an explicit skeleton's stable step "
+         "grows with its square root, for slow processes (consolidation, thaw) where inertia plays no part; "
+         "run.json's mechanical.kinetic_to_work_max says whether it stayed negligible")
+      .defaults_to(1.0)
+      .at_least(1)
+      .at_most(1e12);
+  s.real("transport_scaling", "-",
+         "factor on every thermal conductivity and permeability: heat and pore water move this many times faster, "
+         "so one second of the run stands for this many seconds of conduction and seepage while inertia and "
+         "prescribed speeds keep real time (Yu et al. 2024 use 250 × 86400 in Sec. 5.3); prescribed fluxes and "
+         "heat transfer coefficients are not scaled")
+      .defaults_to(1.0)
+      .at_least(1)
+      .at_most(1e12);
+  return s;
+}
+
+/// The `output:` section.
+ParamSchema output_schema() {
+  ParamSchema s;
+  s.real("every", "s", "simulated time between field frames (fields.h5); 0 = first and last only")
+      .defaults_to(0.0).at_least(0);
+  s.real("metrics_every", "s", "simulated time between metrics.csv rows; 0 = every step").defaults_to(0.0).at_least(0);
+  s.boolean("progress", "print a progress line every 2 s of wall time: simulated time (in s, min, h, d or yr) and its percentage of time.end, step, dt and ETA").defaults_to(true);
+  return s;
+}
+
+/// The `checkpoint:` section.
+ParamSchema checkpoint_schema() {
+  ParamSchema s;
+  s.integer("every_steps", "steps between checkpoints (OUT/checkpoint.h5); 0 = off").defaults_to(0L).at_least(0);
+  s.real("every_minutes", "min", "wall-clock minutes between checkpoints; 0 = off").defaults_to(30.0).at_least(0);
+  s.boolean("at_end",
+            "keep a checkpoint of the finished run, so that `run --restart OUT --set time.end=LATER` can extend it")
+      .defaults_to(true);
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::string> Simulation::sections() {
+  return {"grid",    "time",       "gravity", "physics", "materials", "regions", "boundary_conditions",
+          "output", "probes", "checkpoint"};
+}
+
+std::vector<std::pair<std::string, ParamSchema>> Simulation::section_schemas() {
+  return {{"grid", grid_schema()}, {"time", time_schema()}, {"output", output_schema()},
+          {"checkpoint", checkpoint_schema()}};
+}
+
+void Simulation::read_grid(const ConfigNode& node) {
+  const ParamSet p = parse_params(grid_schema(), node);
   const auto& cells = p.reals("cells");
   const auto& h = p.reals("cell_size");
   if (h.size() != 1 && h.size() != kDim)
@@ -157,28 +214,7 @@ void Simulation::read_grid(const ConfigNode& node) {
 }
 
 void Simulation::read_time(const ConfigNode& node) {
-  ParamSchema s;
-  s.real("end", "s", "simulated end time").above(0);
-  s.real("dt", "s", "fixed time step; 0 = automatic from the physics' stability limits").defaults_to(0.0).at_least(0);
-  s.real("dt_max", "s", "upper bound on an automatic step; 0 = none").defaults_to(0.0).at_least(0);
-  s.integer("max_steps", "most steps, metrics rows or field frames a run may take; a scene needing more is refused")
-      .defaults_to(kDefaultMaxSteps).at_least(1);
-  s.real("mass_scaling", "-",
-         "factor on every inertia (skeleton and pore water; not on weight): an explicit skeleton's stable step "
-         "grows with its square root, for slow processes (consolidation, thaw) where inertia plays no part; "
-         "run.json's mechanical.kinetic_to_work_max says whether it stayed negligible")
-      .defaults_to(1.0)
-      .at_least(1)
-      .at_most(1e12);
-  s.real("transport_scaling", "-",
-         "factor on every thermal conductivity and permeability: heat and pore water move this many times faster, "
-         "so one second of the run stands for this many seconds of conduction and seepage while inertia and "
-         "prescribed speeds keep real time (Yu et al. 2024 use 250 × 86400 in Sec. 5.3); prescribed fluxes and "
-         "heat transfer coefficients are not scaled")
-      .defaults_to(1.0)
-      .at_least(1)
-      .at_most(1e12);
-  const ParamSet p = parse_params(s, node);
+  const ParamSet p = parse_params(time_schema(), node);
   end_time_ = p.real("end");
   fixed_dt_ = p.real("dt");
   max_dt_ = p.real("dt_max");
@@ -195,7 +231,7 @@ void Simulation::read_gravity(const ConfigNode* node) {
     return;
   }
   gravity_where_ = node->where();
-  const auto g = node->as_reals();
+  const auto g = node->as_reals("m/s^2");
   if (g.size() != kDim)
     throw node->error("gravity is a vector of " + std::to_string(kDim) + " components in m/s^2, e.g. [0, -9.81]");
   for (int d = 0; d < kDim; ++d) {
@@ -404,7 +440,7 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
         bc.target_text = "face " + f.name();
         // Part of a face: `from`/`to` along the face's other axis (a footing, a surcharge strip).
         if (auto along = target.optional_child("range")) {
-          const auto r = along->as_reals();
+          const auto r = along->as_reals("m");
           if (r.size() != 2 || !(r[0] < r[1])) throw along->error("expected [from, to] with from < to, in metres");
           const int other = 1 - f.axis;
           std::vector<std::size_t> kept;
@@ -454,16 +490,10 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     bc.node = std::make_unique<ConfigNode>(item);
     bcs_.push_back(std::move(bc));
   }
-  resolved_["boundary_conditions"] = YAML::Clone(node.raw());
 }
 
 void Simulation::read_output(const ConfigNode& node) {
-  ParamSchema s;
-  s.real("every", "s", "simulated time between field frames (fields.h5); 0 = first and last only")
-      .defaults_to(0.0).at_least(0);
-  s.real("metrics_every", "s", "simulated time between metrics.csv rows; 0 = every step").defaults_to(0.0).at_least(0);
-  s.boolean("progress", "print a progress line with time, step, dt and ETA").defaults_to(true);
-  const ParamSet p = parse_params(s, node, {"fields"});
+  const ParamSet p = parse_params(output_schema(), node, {"fields"});
   output_every_ = p.real("every");
   metrics_every_ = p.real("metrics_every");
   if (output_every_ > 0)
@@ -488,13 +518,7 @@ void Simulation::read_output(const ConfigNode& node) {
 }
 
 void Simulation::read_checkpoint(const ConfigNode& node) {
-  ParamSchema s;
-  s.integer("every_steps", "steps between checkpoints (OUT/checkpoint.h5); 0 = off").defaults_to(0L).at_least(0);
-  s.real("every_minutes", "min", "wall-clock minutes between checkpoints; 0 = off").defaults_to(30.0).at_least(0);
-  s.boolean("at_end",
-            "keep a checkpoint of the finished run, so that `run --restart OUT --set time.end=LATER` can extend it")
-      .defaults_to(true);
-  const ParamSet p = parse_params(s, node);
+  const ParamSet p = parse_params(checkpoint_schema(), node);
   checkpoint_every_steps_ = p.integer("every_steps");
   checkpoint_every_minutes_ = p.real("every_minutes");
   checkpoint_at_end_ = p.boolean("at_end");

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "frostmpm/config/units.hpp"
 #include "frostmpm/io/log.hpp"
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/io/particle_field_reader.hpp"
@@ -38,6 +39,16 @@ constexpr const char* kDeformationGradient = "deformation_gradient";
 constexpr const char* kInitialVolume = "volume_initial";
 constexpr const char* kInitialHalfSize = "half_size_initial";
 
+/// "  t = 3.42 h of 50 h (6.8 %)  step 120  dt = 102 s  ETA 31 s": simulated times in the unit
+/// that reads best, the step in s (what time.dt and the stability limits speak of).
+std::string progress_line(double time, double end, long step, double dt, double eta_seconds) {
+  std::ostringstream line;
+  line << "  t = " << units::readable_duration(time) << " of " << units::readable_duration(end) << " ("
+       << std::fixed << std::setprecision(1) << 100.0 * time / end << " %)  step " << step << "  dt = "
+       << std::defaultfloat << std::setprecision(3) << dt << " s  ETA " << units::readable_duration(eta_seconds, 2);
+  return line.str();
+}
+
 double determinant3(const double* F) {
   return F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
 }
@@ -55,10 +66,13 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
   read_physics(root.child("physics"));
   read_materials(root.child("materials"));
   read_regions(root.child("regions"));
-  if (auto bcs = root.optional_child("boundary_conditions")) read_boundary_conditions(*bcs);
-  else resolved_["boundary_conditions"] = YAML::Node(YAML::NodeType::Sequence);
+  const auto bcs = root.optional_child("boundary_conditions");
+  if (bcs) read_boundary_conditions(*bcs);
   for (auto& physics : physics_) physics->setup(*this);
   for (auto& bc : bcs_) bc.node->finish({});  // physics read their keys; anything left is unknown
+  // Copied once the physics have read the values: those given with units are then numbers in
+  // the declared units (ConfigNode::as_real).
+  resolved_["boundary_conditions"] = bcs ? YAML::Clone(bcs->raw()) : YAML::Node(YAML::NodeType::Sequence);
   resolve_step();
   warn_unused_keys();
   apply_initial_values();
@@ -79,6 +93,7 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
     }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
     sources.rigid_body = [this](const std::string& name) { return rigid_body(name); };
+    sources.field_units = state_units_;
     const auto probes = root.optional_child("probes");
     probes_.read(probes ? &*probes : nullptr, std::move(sources));
     resolved_["probes"] = probes_.resolved();
@@ -147,7 +162,10 @@ std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::strin
 }
 
 void Simulation::declare_state_field(const std::string& name, int components, double default_value,
-                                     double max_magnitude, FieldKind kind) {
+                                     const std::string& unit, double max_magnitude, FieldKind kind) {
+  if (const auto it = state_units_.find(name); it != state_units_.end() && it->second != unit)
+    throw std::logic_error("state field '" + name + "' declared in " + it->second + " and in " + unit);
+  state_units_[name] = unit;
   state_bounds_[name] = max_magnitude;
   particles_.declare(name, components, default_value, kind);
   state_defaults_[name] = default_value;
@@ -264,16 +282,15 @@ std::vector<PersistentArray> Simulation::carried_node_fields() {
 namespace {
 /// `{table: [[c0, v0], [c1, v1], ...], along: y}` (a coordinate) or `{table: [[d0, v0], ...],
 /// depth_below: Y}` (depth d = Y − y, a borehole log): linear between the rows, the end values
-/// beyond them. Calls set(p, value) for every particle of the range.
+/// beyond them; coordinates in m, values in `unit`. Calls set(p, value) for every particle of
+/// the range.
 template <class Set>
-void assign_profile(const ConfigNode& node, const ParticleRange& range, std::span<const double> pos, int dim,
-                    Set&& set) {
+void assign_profile(const ConfigNode& node, const std::string& unit, const ParticleRange& range,
+                    std::span<const double> pos, int dim, Set&& set) {
   const ConfigNode table = node.child("table");
   std::vector<double> at, values;
   for (const auto& row : table.elements()) {
-    const auto pair = row.as_reals();
-    if (pair.size() != 2 || !std::isfinite(pair[0]) || !std::isfinite(pair[1]))
-      throw row.error("expected a row [coordinate, value] of two finite numbers");
+    const auto pair = row.as_row({"m", unit}, "a row [coordinate, value] of two finite numbers");
     if (!at.empty() && !(pair[0] > at.back()))
       throw row.error("the table's coordinates must increase strictly (" + number_text(at.back()) + " then " +
                       number_text(pair[0]) + ")");
@@ -288,7 +305,7 @@ void assign_profile(const ConfigNode& node, const ParticleRange& range, std::spa
   int axis = dim - 1;
   double surface = 0;
   if (by_depth) {
-    surface = node.child("depth_below").as_real();
+    surface = node.child("depth_below").as_real("m");
   } else {
     const ConfigNode along = node.child("along");
     const std::string name = along.as_string();
@@ -420,6 +437,7 @@ void Simulation::apply_initial_values() {
         count = particles_.components(field);
       }
       const ParamSpec* spec = material_schema_.find(field);
+      const std::string& unit = state_units_.at(field);
       // What is wrong with a value ("is not a finite number"), empty when it is fine.
       auto problem = [&](double value) -> std::string {
         if (!std::isfinite(value)) return "is not a finite number";
@@ -446,12 +464,12 @@ void Simulation::apply_initial_values() {
           return "at (" + number_text(pos[p * kDim], 6) + ", " + number_text(pos[p * kDim + 1], 6) + ") ";
         };
         if (!value_node.is_map()) {
-          const double value = value_node.as_real();
+          const double value = value_node.as_real(unit);
           for (std::size_t p = init.range.begin; p < init.range.end; ++p) store(p, value, value_node, "the value ");
           return;
         }
         if (value_node.has("table")) {
-          assign_profile(value_node, init.range, pos, kDim, [&](std::size_t p, double value) {
+          assign_profile(value_node, unit, init.range, pos, kDim, [&](std::size_t p, double value) {
             store(p, value, value_node.child("table"), at_particle(p) + "the table's value ");
           });
           return;
@@ -468,7 +486,7 @@ void Simulation::apply_initial_values() {
           if (field != "pore_pressure")
             throw value_node.child("hydrostatic").error("hydrostatic sets pore_pressure only, not '" + key + "'");
           const ConfigNode h = value_node.child("hydrostatic");
-          const double level = h.child("water_table").as_real();
+          const double level = h.child("water_table").as_real("m");
           h.finish({"water_table"});
           value_node.finish({"hydrostatic"});
           double g2 = 0;
@@ -517,6 +535,9 @@ void Simulation::apply_initial_values() {
       }
     }
   }
+  // As read: values given with units are now numbers in the fields' units (ConfigNode::as_real).
+  for (std::size_t r = 0; r < region_inits_.size(); ++r)
+    if (region_inits_[r].node) resolved_["regions"][r]["initial"] = YAML::Clone(region_inits_[r].node->raw());
 }
 
 // ---- geometry and the step ------------------------------------------------------------------------
@@ -899,10 +920,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
       last_print = Clock::now();
       const double wall = std::chrono::duration<double>(last_print - wall_start).count();
       const double eta = wall * (end_time_ - time_) / std::max(time_ - time_start, 1e-300);
-      std::ostringstream line;
-      line << std::setprecision(4) << "  t = " << time_ << " s / " << end_time_ << " s  step " << step_
-           << "  dt = " << dt_ << " s  ETA " << std::fixed << std::setprecision(0) << eta << " s";
-      log::info(line.str());
+      log::info(progress_line(time_, end_time_, step_, dt_, eta));
     }
     if (time_ >= end_time_ - eps) break;
 

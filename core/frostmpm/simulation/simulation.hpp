@@ -67,6 +67,8 @@ class Simulation final : public Kernel<kDim> {
   ~Simulation() override;
 
   static std::vector<std::string> sections();
+  /// The schemas of the kernel's own sections (grid, time, output, checkpoint), by section.
+  static std::vector<std::pair<std::string, ParamSchema>> section_schemas();
   YAML::Node resolved() const { return resolved_; }
 
   /// Runs to the end time, writing fields.h5/.xdmf, metrics.csv into `out`, and checkpoints
@@ -89,7 +91,7 @@ class Simulation final : public Kernel<kDim> {
   std::size_t particle_count() const override { return particles_.size(); }
   const std::vector<ParticleRange>& particle_ranges() const override { return particles_.ranges(); }
   void declare_state_field(const std::string& name, int components, double default_value,
-                           double max_magnitude = std::numeric_limits<double>::infinity(),
+                           const std::string& unit, double max_magnitude = std::numeric_limits<double>::infinity(),
                            FieldKind kind = FieldKind::Other) override;
   void declare_field(const std::string& name, int components, double initial = 0.0,
                      FieldKind kind = FieldKind::Other) override;
@@ -200,6 +202,7 @@ class Simulation final : public Kernel<kDim> {
   std::vector<std::string> output_fields_;
   std::map<std::string, double> state_defaults_;
   std::map<std::string, double> state_bounds_;  ///< largest plausible |initial value| per field
+  std::map<std::string, std::string> state_units_;  ///< the unit of each state field's values
   ParamSchema material_schema_;  ///< every physics' material keys; also bounds `initial:` values
   ParamSet time_params_;
   long max_steps_ = 0;
