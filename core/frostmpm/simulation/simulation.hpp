@@ -88,12 +88,12 @@ class Simulation final : public Kernel<kDim> {
   std::vector<std::string> physics_names() const override { return physics_keys_; }
   std::size_t particle_count() const override { return particles_.size(); }
   const std::vector<ParticleRange>& particle_ranges() const override { return particles_.ranges(); }
-  void declare_state_field(const std::string& name, int components, double default_value,
+  void declare_state_field(const std::string& name, const std::string& unit, int components, double default_value,
                            double max_magnitude = std::numeric_limits<double>::infinity(),
                            FieldKind kind = FieldKind::Other) override;
-  void declare_field(const std::string& name, int components, double initial = 0.0,
+  void declare_field(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
                      FieldKind kind = FieldKind::Other) override;
-  void declare_history(const std::string& name, int components, double initial = 0.0,
+  void declare_history(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
                        FieldKind kind = FieldKind::Other) override;
   bool has_particle_field(const std::string& name) const override { return particles_.has(name); }
   void fill_from_materials(const std::string& field, const std::string& parameter) override;
