@@ -117,6 +117,8 @@ class Simulation final : public Kernel<kDim> {
   long restarts() const { return restarts_; }
   const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
   bool particles_move() const override { return moving_; }
+  /// (column, unit) of every metrics.csv column, in its order.
+  std::vector<std::pair<std::string, std::string>> metrics_units() const { return probes_.column_units(); }
   /// Particles removed after leaving the grid (grid.particles_leaving: remove).
   long removed_particles() const { return static_cast<long>(initial_particles_ - particles_.size()); }
 
