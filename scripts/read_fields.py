@@ -9,11 +9,16 @@ fields.xdmf is parsed with xml.etree; every DataItem "fields.h5:/path" is resolv
 the XDMF file and read with h5py, so only what the XDMF describes is trusted. The XDMF-declared
 Dimensions must match the HDF5 dataset shapes, and the Polyvertex connectivity must be 0..N-1.
 
+Every dataset's "units" attribute (a UDUNITS-2 string: "degC", "Pa", "m/s", "1" for
+dimensionless) comes back as frame["units"][name] (None for output written before FrostMPM
+recorded units) and is printed in the summary.
+
 EXPECTED.json:
     {"frames": [{"time": 0.0, "step": 0, "count": 3,
                  "coordinates": [[x, y], ...],              # dim or 3 columns
                  "fields": {"T": [..], "v": [[vx, vy], ...]},
-                 "types": {"T": "Scalar", "v": "Vector"}}]}  # "types" optional
+                 "types": {"T": "Scalar", "v": "Vector"},   # "types" optional
+                 "units": {"T": "degC", "v": "m/s"}}]}      # "units" optional
 Every key of a frame except "time" is optional. Values must match exactly. Fewer columns than
 stored are accepted when they equal the dataset's "components" attribute (2D coordinates,
 2-vectors padded to 3); the padding must then be zero. The field set must match exactly.
@@ -148,13 +153,14 @@ def read_frames(folder):
                 raise FormatError(f"grid {name}: coordinates shape {coordinates.shape}, expected ({count}, {width})")
             frame["coordinates"] = coordinates
             frame["coordinates_components"] = _components(coord_dset, width)
+            frame["coordinates_units"] = _units(coord_dset)
             if coord_dset is not None:
                 group = coord_dset.parent
                 for key in ("time", "step"):
                     if key in group.attrs:
                         frame["h5_" + key] = group.attrs[key].item()
 
-            fields, types, components = {}, {}, {}
+            fields, types, components, units = {}, {}, {}, {}
             for attribute in grid.findall("Attribute"):
                 fname = attribute.get("Name")
                 if not fname or fname in fields:
@@ -170,7 +176,8 @@ def read_frames(folder):
                     raise FormatError(f"grid {name}: {atype} Attribute {fname} has {ncomp} components")
                 fields[fname], types[fname] = values, atype
                 components[fname] = _components(dset, ncomp)
-            frame.update(fields=fields, types=types, components=components)
+                units[fname] = _units(dset)
+            frame.update(fields=fields, types=types, components=components, units=units)
             frames.append(frame)
     finally:
         reader.close()
@@ -183,6 +190,14 @@ def _components(dset, stored):
     return stored
 
 
+def _units(dset):
+    """The dataset's "units" attribute as text, or None when it has none."""
+    if dset is None or "units" not in dset.attrs:
+        return None
+    value = dset.attrs["units"]
+    return value.decode("utf-8") if isinstance(value, bytes) else str(value)
+
+
 def summary(frames, dump):
     out = {"frames": []}
     for frame in frames:
@@ -192,7 +207,7 @@ def summary(frames, dump):
         entry["dim"] = frame["coordinates_components"]
         entry["fields"] = {}
         for fname, values in frame["fields"].items():
-            info = {"type": frame["types"][fname], "shape": list(values.shape),
+            info = {"type": frame["types"][fname], "units": frame["units"][fname], "shape": list(values.shape),
                     "components": frame["components"][fname]}
             if values.size:
                 info["min"], info["max"] = float(np.min(values)), float(np.max(values))
@@ -265,6 +280,9 @@ def check(frames, expected):
             if frame["types"].get(fname) != atype:
                 problems.append(f"{label}: field {fname} has AttributeType {frame['types'].get(fname)!r}, "
                                 f"expected {atype!r}")
+        for fname, unit in want.get("units", {}).items():
+            if frame["units"].get(fname) != unit:
+                problems.append(f"{label}: field {fname} has units {frame['units'].get(fname)!r}, expected {unit!r}")
     return problems
 
 

@@ -223,6 +223,11 @@ int cmd_run(const SceneOptions& o, const std::string& out_dir, const std::string
     summary["plugins"].push_back({{"name", p.name}, {"version", p.version}, {"library", p.file}});
   summary["resolved_scene"] = to_json(prepared->resolved);
   summary["run"] = to_json(prepared->task->summary());
+  // The CSV keeps its one header line (what spreadsheets and pandas read); its units are here.
+  if (const auto units = prepared->task->metrics_units(); !units.empty()) {
+    summary["metrics_units"] = nlohmann::json::object();
+    for (const auto& [column, unit] : units) summary["metrics_units"][column] = unit;
+  }
   summary["threads"] = thread_count();
   // MPI is linked (Trilinos needs it) but runs are not distributed: one rank, initialized only
   // when a sparse solver ran.

@@ -38,6 +38,8 @@ class SimulationTask final : public Task {
         }
   }
 
+  std::vector<std::pair<std::string, std::string>> metrics_units() const override { return sim_.metrics_units(); }
+
   YAML::Node summary() const override {
     YAML::Node s;
     const auto& st = sim_.statistics();

@@ -6,6 +6,8 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -41,6 +43,9 @@ class Task {
   virtual std::string step_description() const { return {}; }
   /// Task-specific facts for run.json (steps, timings, counters).
   virtual YAML::Node summary() const { return {}; }
+  /// (column, unit) of every column of the metrics.csv the task writes (none: it writes none),
+  /// for run.json's metrics_units.
+  virtual std::vector<std::pair<std::string, std::string>> metrics_units() const { return {}; }
 };
 
 using TaskFactory = std::function<std::unique_ptr<Task>(const TaskContext&)>;

@@ -50,8 +50,10 @@ class TemperatureElastic final : public frostmpm::MechanicalModel {
         freezing_point_(p.real("freezing_point")),
         range_(p.real("stiffening_range")) {}
 
-  // One scalar per particle each, written to fields.h5 under this name.
-  std::vector<std::string> internal_variables() const override { return {"accumulated_shear_strain"}; }
+  // One scalar per particle each, written to fields.h5 under this name with this unit.
+  std::vector<frostmpm::InternalVariable> internal_variables() const override {
+    return {{"accumulated_shear_strain", "1"}};
+  }
   std::vector<double> initial_state() const override { return {0.0}; }
 
   // One call per batch of particles of one material; spans hold n points (× 6 for tensors,

@@ -84,9 +84,9 @@ class DruckerPrager final : public frostmpm::MechanicalModel {
     k_ = 3 * p.real("cohesion") / std::sqrt(9 + 12 * t * t);
   }
 
-  // One scalar per particle each, written to fields.h5 under this name.
-  std::vector<std::string> internal_variables() const override {
-    return {"plastic_shear_strain", "plastic_volumetric_strain", "yielded"};
+  // One scalar per particle each, written to fields.h5 under this name with this unit.
+  std::vector<frostmpm::InternalVariable> internal_variables() const override {
+    return {{"plastic_shear_strain", "1"}, {"plastic_volumetric_strain", "1"}, {"yielded", "1"}};
   }
 
   void integrate(const frostmpm::StressUpdateInput& in, const frostmpm::StressUpdateOutput& out) const override {

@@ -51,9 +51,9 @@ class LinearElastic final : public MechanicalModel {
     if (E_frozen_ == 0) E_frozen_ = E_;
   }
 
-  std::vector<std::string> internal_variables() const override {
+  std::vector<InternalVariable> internal_variables() const override {
     if (!secant_) return {};
-    return {"modulus_of_last_step"};
+    return {{"modulus_of_last_step", "Pa"}};
   }
 
   void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const override {

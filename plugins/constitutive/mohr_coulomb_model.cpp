@@ -121,9 +121,11 @@ MohrCoulombModel::MohrCoulombModel(const ParamSet& p, bool ice) : ice_(ice) {
   lambda_ = p.real("lambda");
 }
 
-std::vector<std::string> MohrCoulombModel::internal_variables() const {
-  return {"plastic_deviatoric_strain", "plastic_volumetric_strain", "yielded", "cohesion", "friction_angle",
-          "dilation_angle"};
+std::vector<InternalVariable> MohrCoulombModel::internal_variables() const {
+  return {{"plastic_deviatoric_strain", "1"}, {"plastic_volumetric_strain", "1"}, {"yielded", "1"},
+          {"cohesion", "Pa"},
+          {"friction_angle", "degree"},
+          {"dilation_angle", "degree"}};
 }
 
 std::vector<double> MohrCoulombModel::initial_state() const {

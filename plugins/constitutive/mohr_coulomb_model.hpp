@@ -29,7 +29,7 @@ class MohrCoulombModel : public MechanicalModel {
   static void declare(ParamSchema& s, bool ice);
   MohrCoulombModel(const ParamSet& p, bool ice);
 
-  std::vector<std::string> internal_variables() const override;
+  std::vector<InternalVariable> internal_variables() const override;
   std::vector<double> initial_state() const override;
   void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const override;
   bool yield_function(std::span<const double> stress, std::span<const double> state,

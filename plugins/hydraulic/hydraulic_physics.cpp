@@ -71,12 +71,12 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   gravity_ = sim.gravity();
   mass_scaling_ = sim.time_params().real("mass_scaling");
   transport_scaling_ = sim.time_params().real("transport_scaling");
-  sim.declare_state_field("porosity", 1, 0.0, "-");
-  sim.declare_state_field("pore_pressure", 1, 0.0, "Pa", /*max_magnitude=*/1e10);
-  sim.declare_field("liquid_saturation", 1, 1.0);  // 1 unless a thermal physics says otherwise
-  sim.declare_field("liquid_velocity", kDim, 0.0, FieldKind::Vector);
-  sim.declare_field("water_flux", kDim, 0.0, FieldKind::Vector);
-  sim.declare_field("liquid_velocity_predicted", kDim, 0.0, FieldKind::Vector);
+  sim.declare_state_field("porosity", "1", 1, 0.0);
+  sim.declare_state_field("pore_pressure", "Pa", 1, 0.0, /*max_magnitude=*/1e10);
+  sim.declare_field("liquid_saturation", "1", 1, 1.0);  // 1 unless a thermal physics says otherwise
+  sim.declare_field("liquid_velocity", "m/s", kDim, 0.0, FieldKind::Vector);
+  sim.declare_field("water_flux", "m/s", kDim, 0.0, FieldKind::Vector);
+  sim.declare_field("liquid_velocity_predicted", "m/s", kDim, 0.0, FieldKind::Vector);
 
   bool compressible = false;
   for (const auto& m : sim.materials()) {

@@ -114,9 +114,10 @@ class HydraulicPhysics final : public Physics {
   FieldHandle node_solid_mobility_ = FieldHandle::node("solid_mobility", kDim);
   FieldHandle node_solid_group_ = FieldHandle::node("solid_group");  ///< nodes moving as one body (rigid plates)
   FieldHandle shear_modulus_ = FieldHandle::particle("shear_modulus");  ///< G of the skeleton's model, when it has one
-  FieldHandle liquid_drag_ = FieldHandle::particle("liquid_drag");
-  FieldHandle liquid_reaction_ = FieldHandle::particle("liquid_reaction", kDim, FieldKind::Vector);
-  FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share");
+  // Created by the drag stage, which runs only with a moving skeleton: the units are given here.
+  FieldHandle liquid_drag_ = FieldHandle::particle("liquid_drag", 1, FieldKind::Scalar, "kg/(m^3 s)");
+  FieldHandle liquid_reaction_ = FieldHandle::particle("liquid_reaction", kDim, FieldKind::Vector, "N/m^3");
+  FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share", 1, FieldKind::Scalar, "1");
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
   double mass_scaling_ = 1;

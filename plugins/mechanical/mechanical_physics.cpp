@@ -191,14 +191,14 @@ template <int Dim>
 void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   kernel_ = &kernel;
   mass_scaling_ = kernel.time_params().real("mass_scaling");
-  kernel.declare_state_field("porosity", 1, 0.0, "-");
-  kernel.declare_state_field("solid_velocity", Dim, 0.0, "m/s", /*max_magnitude=*/1e4, FieldKind::Vector);
-  kernel.declare_field("displacement", Dim, 0.0, FieldKind::Vector);
-  kernel.declare_history("stress", 6, 0.0, FieldKind::SymmetricTensor);
-  kernel.declare_field("strain", 6, 0.0, FieldKind::SymmetricTensor);
-  kernel.declare_field("deformation_gradient", 9, 0.0, FieldKind::Tensor);
-  kernel.declare_field("skeleton_inertia", 1, 0.0);
-  kernel.declare_field("shear_modulus", 1, 0.0);
+  kernel.declare_state_field("porosity", "1", 1, 0.0);
+  kernel.declare_state_field("solid_velocity", "m/s", Dim, 0.0, /*max_magnitude=*/1e4, FieldKind::Vector);
+  kernel.declare_field("displacement", "m", Dim, 0.0, FieldKind::Vector);
+  kernel.declare_history("stress", "Pa", 6, 0.0, FieldKind::SymmetricTensor);
+  kernel.declare_field("strain", "1", 6, 0.0, FieldKind::SymmetricTensor);
+  kernel.declare_field("deformation_gradient", "1", 9, 0.0, FieldKind::Tensor);
+  kernel.declare_field("skeleton_inertia", "kg/m^3");  // the skeleton's (mass-scaled) density
+  kernel.declare_field("shear_modulus", "Pa");
   kernel.fill_from_materials("porosity", "porosity");
 
   for (const auto& m : kernel.materials()) {
@@ -211,23 +211,28 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
     data.ice_density = m.params.real("ice_density");
     data.expansion = m.params.real("solid_thermal_expansion");
     data.k0 = m.params.real("k0");
-    for (const auto& name : data.model->internal_variables()) {
-      auto it = std::find(variable_names_.begin(), variable_names_.end(), name);
-      if (it == variable_names_.end()) {
-        if (kernel.has_particle_field(name))
+    for (const auto& variable : data.model->internal_variables()) {
+      auto it = std::find_if(variable_list_.begin(), variable_list_.end(),
+                             [&](const InternalVariable& v) { return v.name == variable.name; });
+      if (it == variable_list_.end()) {
+        if (kernel.has_particle_field(variable.name))
           throw InputError(section.where, "mechanical model '" + data.model_name + "' names an internal variable '" +
-                                              name + "', which is already a particle field of this scene");
-        variable_names_.push_back(name);
-        it = variable_names_.end() - 1;
+                                              variable.name + "', which is already a particle field of this scene");
+        variable_list_.push_back(variable);
+        it = variable_list_.end() - 1;
+      } else if (it->unit != variable.unit) {
+        throw InputError(section.where, "mechanical model '" + data.model_name + "' gives its internal variable '" +
+                                            variable.name + "' the unit '" + variable.unit + "', another material's model '" +
+                                            it->unit + "'");
       }
-      data.variables.push_back(static_cast<std::size_t>(it - variable_names_.begin()));
+      data.variables.push_back(static_cast<std::size_t>(it - variable_list_.begin()));
     }
     materials_.push_back(std::move(data));
   }
-  variables_.reserve(variable_names_.size());
-  variables_start_.reserve(variable_names_.size());
-  for (const auto& name : variable_names_) {
-    kernel.declare_history(name, 1, 0.0, FieldKind::Scalar);
+  variables_.reserve(variable_list_.size());
+  variables_start_.reserve(variable_list_.size());
+  for (const auto& [name, unit] : variable_list_) {
+    kernel.declare_history(name, unit, 1, 0.0, FieldKind::Scalar);
     variables_.push_back(FieldHandle::particle(name));
     variables_start_.push_back(FieldHandle::particle(ParticleStore::history_name(name)));
   }

@@ -126,7 +126,7 @@ class MechanicalPhysics final : public Physics {
   FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,
       inertia_, shear_, temperature_, saturation_, pore_pressure_, liquid_drag_, liquid_reaction_, liquid_share_;
   FieldHandle node_velocity_, node_predicted_, node_increment_, node_pressure_, node_mobility_, node_group_;
-  std::vector<std::string> variable_names_;                 ///< internal variables of every model, once each
+  std::vector<InternalVariable> variable_list_;             ///< internal variables of every model, once each
   std::vector<FieldHandle> variables_, variables_start_;    ///< their particle fields
 
   // ---- per particle (scratch and the step's moduli)

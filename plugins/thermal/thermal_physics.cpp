@@ -66,11 +66,11 @@ ThermalPhysics::ThermalPhysics(const ParamSet& p) : params_(p) {
 void ThermalPhysics::setup(Kernel<kDim>& sim) {
   kernel_ = &sim;
   transport_scaling_ = sim.time_params().real("transport_scaling");
-  sim.declare_state_field("temperature", 1, 0.0, "degC", /*max_magnitude=*/1e4);
-  sim.declare_state_field("porosity", 1, 0.0, "-");
-  sim.declare_field("temperature_pic", 1);
-  sim.declare_field("liquid_saturation", 1, 1.0);
-  sim.declare_field("heat_deviation", 1, 0.0);
+  sim.declare_state_field("temperature", "degC", 1, 0.0, /*max_magnitude=*/1e4);
+  sim.declare_state_field("porosity", "1", 1, 0.0);
+  sim.declare_field("temperature_pic", "degC");
+  sim.declare_field("liquid_saturation", "1", 1, 1.0);
+  sim.declare_field("heat_deviation", "J/m^3");  // heat content minus the grid field's, per volume
 
   const auto average = params_.string("conductivity_average") == "geometric" ? ConductivityAverage::Geometric
                                                                             : ConductivityAverage::Arithmetic;

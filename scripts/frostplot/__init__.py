@@ -1,5 +1,7 @@
 """Shared helpers for FrostMPM's figure scripts (plot.py, plot_paper.py): matplotlib set-up,
-run-folder readers and the panels more than one figure draws.
+run-folder readers and the panels more than one figure draws. `frostplot.units` turns the
+recorded units into labels and reads times such as "30d"; `frostplot.lines` finds columns
+and follows a field along a vertical line.
 
 Import after `sys.path.insert(0, <scripts folder>)`. Needs Debian's /usr/bin/python3
 (python3-matplotlib, python3-numpy; python3-h5py for particle fields).
@@ -13,7 +15,9 @@ try:
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.colors as mcolors
     import matplotlib.pyplot as plt  # noqa: F401  (re-exported)
+    import matplotlib.ticker as mticker
     import matplotlib.tri as mtri
     import numpy as np
 except ImportError as error:  # pragma: no cover - depends on the machine
@@ -21,6 +25,8 @@ except ImportError as error:  # pragma: no cover - depends on the machine
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import read_fields  # noqa: E402,F401  (re-exported)
+
+from frostplot import lines, units  # noqa: E402,F401  (re-exported)
 
 DPI = 120
 
@@ -52,18 +58,13 @@ def run_summary(folder):
         return {}
 
 
+def metrics_units(folder):
+    """{metrics.csv column: unit} from run.json; {} for a run written before units were
+    recorded (or still running: run.json is written at its end)."""
+    return run_summary(folder).get("metrics_units", {})
+
+
 # ---- axes ----------------------------------------------------------------------------------
-
-TIME_UNITS = [(1.0, "s"), (60.0, "min"), (3600.0, "h"), (86400.0, "d"), (365.25 * 86400.0, "yr")]
-
-
-def time_unit(seconds):
-    """(divisor, name) of the largest unit in which the span `seconds` is at least 2."""
-    divisor, name = TIME_UNITS[0]
-    for d, n in TIME_UNITS:
-        if seconds >= 2 * d:
-            divisor, name = d, n
-    return divisor, name
 
 
 def aspect(frame):
@@ -83,31 +84,113 @@ def save(fig, path):
 # ---- panels ----------------------------------------------------------------------------------
 
 
-def field_panel(ax, fig, frame, name, levels=None, cmap="coolwarm", zero_line=False, label=None):
-    """One scalar particle field of a fields.h5 frame on axes `ax`: filled contours over the
-    particles' Delaunay triangulation (triangles much longer than the particle spacing are
-    masked so holes and re-entrant corners stay empty), or a profile line when the particles lie
-    on one line. `zero_line` draws the value-0 contour in black (the 0 °C isotherm)."""
-    xy = frame["coordinates"]
-    x = xy[:, 0]
-    y = xy[:, 1] if xy.shape[1] > 1 else np.zeros_like(x)
-    v = frame["fields"][name]
-    label = label or name
-    if np.ptp(y) <= 1e-12 * max(1.0, np.ptp(x)) or len(x) < 3:
-        order = np.argsort(x)
-        ax.plot(x[order], v[order], ".-", ms=2)
-        ax.set(xlabel="x [m]", ylabel=label)
+def field_panel(ax, fig, frame, name, levels=None, cmap="coolwarm", zero_line=False, label=None, stretch=False):
+    """One scalar particle field of a fields.h5 frame on axes `ax` (see scalar_panel)."""
+    return scalar_panel(ax, fig, frame, frame["fields"][name], label or name, levels, cmap, zero_line, stretch)
+
+
+def scalar_panel(ax, fig, frame, values, label, levels=None, cmap="coolwarm", zero_line=False, stretch=False):
+    """Per-particle `values` of a frame on axes `ax`: a profile when the particles form a column
+    or layer at most two particles across (nothing to triangulate), else filled contours over
+    the particles' Delaunay triangulation (triangles much longer than the particle spacing are
+    masked so holes and re-entrant corners stay empty). `zero_line` draws the value-0 contour
+    in black (the 0 °C isotherm) and centres the colour map on 0; `stretch` draws x out of
+    scale (a tall, narrow domain)."""
+    xy = lines.planar(frame)
+    axis = lines.line_axis(frame) if len(xy) >= 3 else int(np.ptp(xy[:, 0]) == 0)
+    tri = None if axis is not None else triangulation(xy)
+    if tri is None:
+        profile_panel(ax, xy, [(values, None)], 1 if axis is None else axis, label, zero_line)
         return
-    tri = mtri.Triangulation(x, y)
-    edges = np.hypot(x[tri.edges[:, 0]] - x[tri.edges[:, 1]], y[tri.edges[:, 0]] - y[tri.edges[:, 1]])
-    longest = np.max(np.hypot(np.diff(x[tri.triangles], axis=1, append=x[tri.triangles][:, :1]),
-                              np.diff(y[tri.triangles], axis=1, append=y[tri.triangles][:, :1])), axis=1)
-    tri.set_mask(longest > 3 * np.median(edges))
-    low, high = float(np.nanmin(v)), float(np.nanmax(v))
-    if levels is None and high - low <= 1e-9 * max(1.0, abs(high)):  # a uniform field
-        levels = np.linspace(low - 0.5, high + 0.5, 3) if high - low < 1 else 21
-    c = ax.tricontourf(tri, v, levels=levels if levels is not None else 21, cmap=cmap, extend="both")
-    if zero_line and np.nanmin(v) < 0 < np.nanmax(v):
-        ax.tricontour(tri, v, levels=[0.0], colors="k", linewidths=1)
+    low, high = float(np.nanmin(values)), float(np.nanmax(values))
+    levels, norm = colour_scale(low, high, zero_line, levels)
+    c = ax.tricontourf(tri, values, levels=levels, cmap=cmap, norm=norm, extend="both")
+    if zero_line and low < 0 < high:
+        ax.tricontour(tri, values, levels=[0.0], colors="k", linewidths=1)
     fig.colorbar(c, ax=ax, label=label)
-    ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]")
+    ax.set(aspect="auto" if stretch else "equal", xlabel="x [m] (not to scale)" if stretch else "x [m]",
+           ylabel="y [m]")
+
+
+def colour_scale(low, high, centre_on_zero=False, levels=None):
+    """(levels, norm) for filled contours of values from low to high: the given levels, or
+    about 20 round ones (three around a uniform value, which has none of its own); with
+    `centre_on_zero`, a norm that puts 0 at the colour map's centre (on coolwarm: frozen blue,
+    thawed red, also when every value lies on one side)."""
+    if levels is None and high - low <= 1e-9 * max(1.0, abs(high)):
+        levels = np.linspace(low - 0.5, high + 0.5, 3)
+    elif levels is None:
+        levels = mticker.MaxNLocator(20).tick_values(low, high)
+    if not centre_on_zero:
+        return levels, None
+    if levels[0] < 0 < levels[-1]:
+        return levels, mcolors.TwoSlopeNorm(0.0, levels[0], levels[-1])
+    reach = max(abs(levels[0]), abs(levels[-1]))
+    return levels, mcolors.Normalize(-reach, reach)
+
+
+def triangulation(xy):
+    """The particles' Delaunay triangulation with over-long triangles masked; None when Qhull
+    cannot triangulate them (points too close to a line)."""
+    x, y = xy[:, 0], xy[:, 1]
+    try:
+        tri = mtri.Triangulation(x, y)
+    except (RuntimeError, ValueError):
+        return None
+    edges = np.hypot(x[tri.edges[:, 0]] - x[tri.edges[:, 1]], y[tri.edges[:, 0]] - y[tri.edges[:, 1]])
+    corners_x, corners_y = x[tri.triangles], y[tri.triangles]
+    longest = np.max(np.hypot(np.diff(corners_x, axis=1, append=corners_x[:, :1]),
+                              np.diff(corners_y, axis=1, append=corners_y[:, :1])), axis=1)
+    tri.set_mask(longest > 3 * np.median(edges))
+    return tri
+
+
+def profile_panel(ax, xy, series, axis, label, zero_line=False):
+    """Values along a column (axis 1: y upwards, values across) or a layer (axis 0: x across):
+    `series` is a list of (per-particle values, legend label or None); particles at one
+    coordinate are averaged."""
+    tol = lines.tolerance(xy)
+    for values, name in series:
+        where, mean = lines.averaged_along(xy[:, axis], values, tol)
+        if axis == 1:
+            ax.plot(mean, where, ".-", ms=2, label=name)
+        else:
+            ax.plot(where, mean, ".-", ms=2, label=name)
+    if zero_line:
+        (ax.axvline if axis == 1 else ax.axhline)(0.0, color="k", lw=0.6)
+    if any(name for _, name in series):
+        ax.legend(fontsize=8)
+    if axis == 1:
+        ax.set(xlabel=label, ylabel="y [m]")
+    else:
+        ax.set(xlabel="x [m]", ylabel=label)
+    ax.grid(alpha=0.3)
+
+
+def round_number(value):
+    """1, 2 or 5 times a power of ten, at most `value` (> 0)."""
+    power = 10.0 ** np.floor(np.log10(value))
+    return max(m for m in (1, 2, 5) if m * power <= value * (1 + 1e-12)) * power
+
+
+def arrows(ax, frame, vectors, unit, per_side=20):
+    """Arrows of a vector field (its x and y components), averaged over square bins about
+    `per_side` to the longer side of the particles' extent, with a key arrow of a round
+    magnitude in `unit` above the axes' right end (put the title left). White with a black
+    edge, so they show on any colour map. Draws nothing where the field is zero everywhere."""
+    xy = lines.planar(frame)
+    size = float(np.max(np.ptp(xy, axis=0))) / per_side
+    if size <= 0:
+        return
+    cells = np.floor((xy - xy.min(axis=0)) / size).astype(np.int64)
+    _, bin_of = np.unique(cells[:, 0] * (cells[:, 1].max() + 1) + cells[:, 1], return_inverse=True)
+    count = np.bincount(bin_of)
+    mean = [np.bincount(bin_of, column) / count for column in (xy[:, 0], xy[:, 1], vectors[:, 0], vectors[:, 1])]
+    largest = float(np.max(np.hypot(mean[2], mean[3])))
+    if not largest > 0:
+        return
+    q = ax.quiver(*mean, color="w", edgecolor="k", linewidth=0.5, pivot="mid", angles="xy", width=0.005)
+    key = round_number(largest)
+    shown = units.pretty(unit)
+    ax.quiverkey(q, 0.9, 1.04, key, f"{key:g} {shown}" if shown else f"{key:g}", labelpos="W",
+                 coordinates="axes", fontproperties={"size": 8})

@@ -321,7 +321,7 @@ class MemoryPhysics final : public Physics {
   std::vector<std::string> boundary_types() const override { return {}; }
   void setup(Kernel<2>& sim) override {
     sim_ = &sim;
-    sim.declare_state_field(field(), 1, 0.0, "-");
+    sim.declare_state_field(field(), "1", 1, 0.0);
     nodal_.assign(sim.grid().node_count(), 0.0);
   }
   std::vector<Stage> stages() override {

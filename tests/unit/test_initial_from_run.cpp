@@ -43,9 +43,9 @@ TEST_CASE("ParticleFieldReader: frames in step order, positions and fields as wr
   for (std::size_t i = 0; i < v.size(); ++i) v[i] = 0.1 * double(i);
   {
     ParticleFieldWriter writer(dir.path(), 2);
-    writer.write(0.0, 0, 6, pos.data(), {{"temperature", T.data(), 1}, {"solid_velocity", v.data(), 2}});
+    writer.write(0.0, 0, 6, pos.data(), {{"temperature", T.data(), 1, "degC"}, {"solid_velocity", v.data(), 2, "m/s"}});
     for (double& t : T) t += 10;
-    writer.write(5.0, 50, 6, pos.data(), {{"temperature", T.data(), 1}, {"solid_velocity", v.data(), 2}});
+    writer.write(5.0, 50, 6, pos.data(), {{"temperature", T.data(), 1, "degC"}, {"solid_velocity", v.data(), 2, "m/s"}});
   }
   const ParticleFieldReader reader(dir.path());
   REQUIRE(reader.dim() == 2);

@@ -86,7 +86,7 @@ const frostmpm::Registry& broken_registry() {
 class RadialReturn final : public MechanicalModel {
  public:
   RadialReturn(double yield_stress, double tangent_error = 0) : yield_(yield_stress), error_(tangent_error) {}
-  std::vector<std::string> internal_variables() const override { return {"plastic_strain"}; }
+  std::vector<frostmpm::InternalVariable> internal_variables() const override { return {{"plastic_strain", "1"}}; }
   void integrate(const frostmpm::StressUpdateInput& in, const frostmpm::StressUpdateOutput& out) const override {
     const double G = E_ / (2 * (1 + nu_)), K = E_ / (3 * (1 - 2 * nu_));
     for (std::size_t p = 0; p < in.stress_start.size() / 6; ++p) {
@@ -304,7 +304,7 @@ TEST_CASE("linear_elastic with modulus_change elastic_strain: melting ice scales
           "[mechanical]") {
   const auto model = make_model("linear_elastic", "youngs_modulus: 1.0e7, poisson_ratio: 0.2, frozen_youngs_modulus: "
                                                   "1.0e9, modulus_change: elastic_strain");
-  REQUIRE(model->internal_variables() == std::vector<std::string>{"modulus_of_last_step"});
+  REQUIRE(model->internal_variables() == std::vector<frostmpm::InternalVariable>{{"modulus_of_last_step", "Pa"}});
   auto step = [&](const Voigt& strain, const Voigt& start, double S_c, double state_in, double& state_out) {
     Voigt stress{};
     const double ice[1] = {S_c};

@@ -70,6 +70,7 @@ struct ExpectedField {
   std::vector<double> values;
   int components;
   std::string type;
+  std::string unit;
 };
 
 struct ExpectedFrame {
@@ -82,7 +83,7 @@ struct ExpectedFrame {
   std::size_t count() const { return positions.size() / dim; }
   std::vector<FieldView> views() const {
     std::vector<FieldView> out;
-    for (const auto& f : fields) out.push_back({f.name, f.values.data(), f.components});
+    for (const auto& f : fields) out.push_back({f.name, f.values.data(), f.components, f.unit});
     return out;
   }
 };
@@ -95,13 +96,14 @@ std::string expected_json(const std::vector<ExpectedFrame>& frames) {
     out += " {\"time\": " + num(f.time) + ", \"step\": " + std::to_string(f.step) +
            ", \"count\": " + std::to_string(f.count()) + ",\n  \"coordinates\": " + json_array(f.positions, f.dim) +
            ",\n  \"fields\": {";
-    std::string types;
+    std::string types, units;
     for (std::size_t k = 0; k < f.fields.size(); ++k) {
       const auto& field = f.fields[k];
       out += (k ? ", " : "") + ("\"" + field.name + "\": ") + json_array(field.values, field.components);
       types += (k ? ", " : "") + ("\"" + field.name + "\": \"" + field.type + "\"");
+      units += (k ? ", " : "") + ("\"" + field.name + "\": \"" + field.unit + "\"");
     }
-    out += "},\n  \"types\": {" + types + "}}";
+    out += "},\n  \"types\": {" + types + "},\n  \"units\": {" + units + "}}";
   }
   return out + "\n]}\n";
 }
@@ -118,7 +120,7 @@ frostmpm::test::CommandResult check_with_reader(const TempDir& tmp, const std::s
 /// A small 2D cloud whose values are awkward doubles (thirds, ulps, tiny and huge magnitudes).
 ExpectedFrame cloud_2d(double time, long step, std::size_t count) {
   ExpectedFrame f{time, step, {}, 2, {}};
-  ExpectedField T{"T", {}, 1, "Scalar"}, v{"velocity", {}, 2, "Vector"};
+  ExpectedField T{"T", {}, 1, "Scalar", "degC"}, v{"velocity", {}, 2, "Vector", "m/s"};
   for (std::size_t i = 0; i < count; ++i) {
     const double s = static_cast<double>(i) + time;
     f.positions.push_back(0.1 * s + 1.0 / 3.0);
@@ -183,6 +185,14 @@ TEST_CASE("ParticleFieldWriter: 2D frames with a changing particle count read ba
     REQUIRE(bad.exit_code == 1);
     REQUIRE_THAT(bad.output, Contains("frame 2") && Contains("field T"));
   }
+  SECTION("the check notices a wrong unit") {
+    auto changed = frames;
+    changed[1].fields[1].unit = "m/d";
+    const auto bad = check_with_reader(tmp, out, changed, "changed.json");
+    INFO(bad.output);
+    REQUIRE(bad.exit_code == 1);
+    REQUIRE_THAT(bad.output, Contains("frame 1") && Contains("field velocity has units 'm/s', expected 'm/d'"));
+  }
   SECTION("the check notices a missing frame and a wrong time") {
     auto changed = frames;
     changed.pop_back();
@@ -197,7 +207,8 @@ TEST_CASE("ParticleFieldWriter: 2D frames with a changing particle count read ba
     INFO(summary.output);
     REQUIRE(summary.exit_code == 0);
     REQUIRE_THAT(summary.output, Contains("\"name\": \"step_000000\"") && Contains("\"name\": \"step_000010\"") &&
-                                     Contains("\"name\": \"step_000025\"") && Contains("\"type\": \"Vector\""));
+                                     Contains("\"name\": \"step_000025\"") && Contains("\"type\": \"Vector\"") &&
+                                     Contains("\"units\": \"degC\""));
   }
 }
 
@@ -267,6 +278,11 @@ TEST_CASE("ParticleFieldWriter: non-finite values and bad arguments are refused 
   auto no_components = good;
   no_components.fields[0].components = 0;
   REQUIRE_THROWS_AS(write_frame(writer, no_components), std::invalid_argument);
+  for (const char* unit : {"", "deg\nC"}) {
+    auto bad_unit = good;
+    bad_unit.fields[0].unit = unit;
+    REQUIRE_THROWS_AS(write_frame(writer, bad_unit), std::invalid_argument);
+  }
   REQUIRE_THROWS_AS(ParticleFieldWriter(tmp.file("other"), 1), std::invalid_argument);
 
   REQUIRE(writer.frames() == 0);
@@ -290,7 +306,7 @@ TEST_CASE("ParticleFieldWriter: 3D fields map to XDMF Scalar, Vector, Tensor6, T
   const std::vector<std::pair<int, std::string>> layouts = {
       {1, "Scalar"}, {3, "Vector"}, {6, "Tensor6"}, {9, "Tensor"}, {4, "Matrix"}, {2, "Vector"}};
   for (const auto& [components, type] : layouts) {
-    ExpectedField field{"f" + std::to_string(components), {}, components, type};
+    ExpectedField field{"f" + std::to_string(components), {}, components, type, "kg/(m^3 s)"};
     for (std::size_t i = 0; i < count * components; ++i) field.values.push_back(1.0 / (i + components + 1.0));
     f.fields.push_back(field);
   }

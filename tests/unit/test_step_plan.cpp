@@ -40,7 +40,7 @@ std::string error_of(std::vector<StepPlan::Declared> stages, const std::vector<s
 TEST_CASE("step plan: phases run in their order, and inside a phase readers after writers", "[step]") {
   // Declared in the worst order: the THM step's stages backwards.
   const auto plan = StepPlan::resolve(
-      {stage("m.stress", Phase::UpdateMaterials, {particle_field("velocity", 2)}, {particle_field("stress", 3)}),
+      {stage("m.stress", Phase::UpdateMaterials, {particle_field("velocity", 2)}, {particle_field("stress", 3, "Pa")}),
        stage("h.correct", Phase::CorrectMomentum, {node_field("pressure"), node_field("v_star", 2)},
              {node_field("velocity", 2)}),
        stage("h.pressure", Phase::Pressure, {node_field("v_star", 2)}, {node_field("pressure")}),
@@ -50,7 +50,7 @@ TEST_CASE("step plan: phases run in their order, and inside a phase readers afte
              {node_field("temperature")}),
        stage("h.to_grid", Phase::MapToGrid, {particle_field("velocity", 2)}, {node_field("velocity", 2)}),
        // Same phase, reader declared before its writer.
-       stage("x.reads_grid_T", Phase::MapToGrid, {node_field("temperature")}, {particle_field("probe")}),
+       stage("x.reads_grid_T", Phase::MapToGrid, {node_field("temperature")}, {particle_field("probe", 1, "degC")}),
        stage("t.to_grid", Phase::MapToGrid, {particle_field("temperature")}, {node_field("temperature")}),
        stage("h.to_particles", Phase::MapToParticles, {node_field("velocity", 2)}, {particle_field("velocity", 2)})},
       {"temperature", "velocity"});
@@ -61,8 +61,8 @@ TEST_CASE("step plan: phases run in their order, and inside a phase readers afte
   for (const auto& f : plan.node_fields()) nodal.push_back(f.name);
   CHECK(nodal == std::vector<std::string>{"pressure", "temperature", "v_star", "velocity"});
   std::vector<std::string> added;
-  for (const auto& f : plan.new_particle_fields()) added.push_back(f.name);
-  CHECK(added == std::vector<std::string>{"probe", "stress"});
+  for (const auto& f : plan.new_particle_fields()) added.push_back(f.name + " [" + f.unit + "]");
+  CHECK(added == std::vector<std::string>{"probe [degC]", "stress [Pa]"});
   const std::string text = plan.describe();
   CHECK(text.find("  2. energy\n    t.solve\n      reads  node:     temperature, velocity[2]\n") != std::string::npos);
   CHECK(text.find("nodal fields allocated: pressure, temperature, v_star[2], velocity[2]") != std::string::npos);
@@ -101,4 +101,22 @@ TEST_CASE("step plan: a cycle and a field with two shapes are refused", "[step]"
                                 stage("q", Phase::Energy, {node_field("velocity", 3)}, {})});
   CHECK(shapes.find("stage 'q' declares node field 'velocity' with 3 components, stage 'p' with 2") !=
         std::string::npos);
+}
+
+TEST_CASE("step plan: a particle field a stage creates takes the unit its writer gives, and needs one", "[step]") {
+  // The unit may come with any naming of the field, here the reader's.
+  const auto plan = StepPlan::resolve({stage("a.make", Phase::MapToGrid, {}, {particle_field("drag")}),
+                                       stage("b.use", Phase::Energy, {particle_field("drag", 1, "kg/(m^3 s)")}, {})},
+                                      {});
+  REQUIRE(plan.new_particle_fields().size() == 1);
+  CHECK(plan.new_particle_fields()[0].unit == "kg/(m^3 s)");
+  CHECK(error_of({stage("a.make", Phase::MapToGrid, {}, {particle_field("drag")})}) ==
+        "scene.yaml:3:3: at 'physics.a': stage 'a.make' writes particle field 'drag', which no physics declares in "
+        "setup(), and gives no unit for it: declare it there (declare_field(name, unit, ...)) or give the handle of "
+        "its writer a unit");
+  CHECK(error_of({stage("a.make", Phase::MapToGrid, {}, {particle_field("drag", 1, "Pa")}),
+                  stage("b.use", Phase::Energy, {particle_field("drag", 1, "m")}, {})}) ==
+        "scene.yaml:3:3: at 'physics.a': stage 'b.use' declares particle field 'drag' in 'm', stage 'a.make' in 'Pa'");
+  // A field the scene has keeps its declaration's unit: its handles need none.
+  CHECK(error_of({stage("a.make", Phase::MapToGrid, {}, {particle_field("temperature")})}, {"temperature"}).empty());
 }

@@ -1,5 +1,6 @@
 #include "frostmpm/config/units.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <charconv>
@@ -78,7 +79,7 @@ bool temperature_related(const ut_unit* unit) {
 }
 
 std::string name_of(const std::string& declared, const ut_unit* unit) {
-  if (declared == "-") return "a pure number";
+  if (declared == "-" || declared == "1") return "a pure number";
   if (temperature_related(unit)) return offset_temperature(unit) ? "a temperature" : "a temperature difference";
   // The first entry of the declared unit's dimension names it.
   static const std::array<std::pair<const char*, const char*>, 20> kNames = {{
@@ -166,6 +167,11 @@ bool is_declarable(const std::string& unit) {
   if (unit.empty() || unit == "-") return true;
   const std::lock_guard lock(udunits_mutex());
   return parse(unit) != nullptr;
+}
+
+bool is_output_unit(const std::string& unit) {
+  const bool printable = std::all_of(unit.begin(), unit.end(), [](char c) { return c >= 0x20 && c < 0x7f && c != '"'; });
+  return printable && !unit.empty() && unit != "-" && is_declarable(unit);
 }
 
 std::string quantity_name(const std::string& declared) {

@@ -41,6 +41,12 @@ double convert(const Quantity& quantity, const std::string& declared);
 /// is read once, on first use; safe to call from several threads.)
 bool is_declarable(const std::string& unit);
 
+/// Whether `unit` may label an output (a particle field's `units` attribute in fields.h5, a
+/// metrics.csv column in run.json, a model's internal variable): UDUNITS-2 text it parses
+/// ("degC", "m/s", "1" when dimensionless), printable ASCII without '"' since it is written
+/// unchanged into HDF5 and JSON. Not "-" nor "" (those are for schemas only).
+bool is_output_unit(const std::string& unit);
+
 /// What a declared unit measures, for messages: "a time", "a pressure", "a temperature
 /// difference"; "" when it has no common name.
 std::string quantity_name(const std::string& declared);

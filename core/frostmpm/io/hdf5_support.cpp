@@ -205,6 +205,10 @@ void write_attribute(Id object, const std::string& name, std::int64_t value) {
 void write_attribute(Id object, const std::string& name, int value) {
   write_scalar_attribute(object, name, H5T_NATIVE_INT, value);
 }
+void write_attribute(Id object, const std::string& name, const std::string& value) {
+  const Handle type = vl_string_type();
+  write_scalar_attribute(object, name, type.get(), value.c_str());
+}
 double read_real_attribute(Id object, const std::string& name) {
   return read_scalar_attribute<double>(object, name, H5T_NATIVE_DOUBLE);
 }
@@ -213,7 +217,7 @@ std::int64_t read_integer_attribute(Id object, const std::string& name) {
 }
 
 void write_dataset(Id group, const std::string& name, Id file_type, Id mem_type, const std::vector<std::size_t>& dims,
-                   const void* data, int components_attribute) {
+                   const void* data, int components_attribute, const std::string& units_attribute) {
   const std::vector<hsize_t> shape(dims.begin(), dims.end());
   const Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose,
                      "H5Screate_simple for " + name);
@@ -222,6 +226,7 @@ void write_dataset(Id group, const std::string& name, Id file_type, Id mem_type,
   if (H5Sget_simple_extent_npoints(space.get()) > 0)
     check(H5Dwrite(dset.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "writing " + name);
   if (components_attribute > 0) write_attribute(dset.get(), "components", components_attribute);
+  if (!units_attribute.empty()) write_attribute(dset.get(), "units", units_attribute);
 }
 
 std::vector<std::size_t> dataset_shape(Id group, const std::string& name) {

@@ -81,14 +81,18 @@ std::vector<std::string> attribute_names(Id object);
 void write_attribute(Id object, const std::string& name, double value);
 void write_attribute(Id object, const std::string& name, std::int64_t value);
 void write_attribute(Id object, const std::string& name, int value);
+/// A variable-length UTF-8 string (h5py reads it as str).
+void write_attribute(Id object, const std::string& name, const std::string& value);
 double read_real_attribute(Id object, const std::string& name);
 std::int64_t read_integer_attribute(Id object, const std::string& name);
 
 /// Creates dataset `name` in `group` with shape `dims` and writes `data` (may be null when the
 /// dataset is empty); `file_type` and `mem_type` are HDF5 type ids (H5T_IEEE_F64LE, ...).
-/// A positive `components_attribute` is stored as the dataset's "components" attribute.
+/// A positive `components_attribute` is stored as the dataset's "components" attribute, a
+/// non-empty `units_attribute` as its "units" attribute.
 void write_dataset(Id group, const std::string& name, Id file_type, Id mem_type,
-                   const std::vector<std::size_t>& dims, const void* data, int components_attribute = 0);
+                   const std::vector<std::size_t>& dims, const void* data, int components_attribute = 0,
+                   const std::string& units_attribute = {});
 /// Shape of dataset `name` in `group`.
 std::vector<std::size_t> dataset_shape(Id group, const std::string& name);
 /// Size in bytes of one element of dataset `name`.

@@ -18,6 +18,7 @@
 #include "frostmpm/io/hdf5_support.hpp"
 #include "frostmpm/io/output_dir.hpp"
 #include "frostmpm/io/particle_field_reader.hpp"
+#include "frostmpm/config/units.hpp"
 
 namespace frostmpm {
 
@@ -217,7 +218,7 @@ struct ParticleFieldWriter::Impl {
     std::vector<double> xyz(count * 3, 0.0);
     for (std::size_t p = 0; p < count; ++p)
       for (int c = 0; c < dim; ++c) xyz[3 * p + c] = positions[dim * p + c];
-    hdf5::write_dataset(group.get(), "coordinates", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {count, 3}, xyz.data(), dim);
+    hdf5::write_dataset(group.get(), "coordinates", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {count, 3}, xyz.data(), dim, "m");
 
     for (const auto& field : fields) {
       const int columns = attribute_layout(field.components).second;
@@ -231,7 +232,8 @@ struct ParticleFieldWriter::Impl {
       }
       const std::vector<std::size_t> dims =
           columns == 1 ? std::vector<std::size_t>{count} : std::vector<std::size_t>{count, std::size_t(columns)};
-      hdf5::write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, field.components);
+      hdf5::write_dataset(group.get(), field.name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, field.components,
+                          field.unit);
       layout.fields.emplace_back(field.name, field.components);
     }
     return layout;
@@ -312,6 +314,9 @@ void ParticleFieldWriter::write(double time, long step, std::size_t count, const
                                   std::to_string(field.components) + " components");
     if (count > 0 && !field.data)
       throw std::invalid_argument("ParticleFieldWriter: field '" + field.name + "' has no data");
+    if (!units::is_output_unit(field.unit))
+      throw std::invalid_argument("ParticleFieldWriter: field '" + field.name + "' has the unit '" + field.unit +
+                                  "' (give one such as \"degC\", or \"1\" when dimensionless)");
   }
   if (count > 0) {
     require_finite(positions, count, m.dim, "positions", step);

@@ -4,12 +4,13 @@
 //
 // HDF5 layout (one group per frame, named after the step number):
 //   /step_000120/                attributes: time (double), step (int64), count (int64)
-//       coordinates  count x 3   positions; z = 0 for 2D runs              attribute components = dim
+//       coordinates  count x 3   positions; z = 0 for 2D runs   attributes components = dim, units = "m"
 //       connectivity count       0..count-1 (the Polyvertex cells ParaView needs to draw points)
 //       <field>      count       one component  -> XDMF Scalar
 //                    count x 3   2 or 3 components (2 padded with zeros) -> Vector
 //                    count x 6   -> Tensor6;  count x 9 -> Tensor;  count x c otherwise -> Matrix
-//                                every field dataset has attribute components = c as given
+//                                every field dataset has attributes components = c as given and
+//                                units (a UDUNITS-2 string, variable-length UTF-8: "degC", "m/s")
 //   root attribute dim (int).
 //
 // Restart: reopen() keeps the first frames of an existing fields.h5 (those a checkpoint knows
@@ -36,6 +37,7 @@ struct FieldView {
   std::string name;  ///< letters, digits, '_', '-', '.' (not first); not "coordinates"/"connectivity"
   const double* data = nullptr;
   int components = 1;
+  std::string unit;  ///< "degC", "m/s", "1" (frostmpm/config/units.hpp)
 };
 
 class ParticleFieldWriter {
@@ -57,7 +59,7 @@ class ParticleFieldWriter {
 
   /// Appends one output time: positions (count*dim) and fields. The particle count may change
   /// between writes. Throws std::runtime_error naming the array ("positions" or the field name)
-  /// if a value is not finite, and std::invalid_argument for a bad field name/components, a
+  /// if a value is not finite, and std::invalid_argument for a bad field name/components/unit, a
   /// repeated field name, a step already written, a negative step or a non-finite time. Nothing
   /// is written when it throws, and the writer stays usable. A failed write (full disk) is an
   /// OutputError naming the file and step; the frames before it stay readable.

@@ -47,13 +47,21 @@ struct StressUpdateOutput {
   std::span<double> shear_modulus;          ///< G now [Pa], for the pressure stabilization (optional)
 };
 
+/// An internal variable of a model: a scalar per particle, a particle field of the scene (its
+/// values written to fields.h5 with `unit` when the scene's output lists it).
+struct InternalVariable {
+  std::string name;
+  std::string unit;  ///< UDUNITS-2 text: "1" when dimensionless, "Pa", "degree" (frostmpm/config/units.hpp)
+  bool operator==(const InternalVariable&) const = default;
+};
+
 class MechanicalModel {
  public:
   static constexpr const char* kKind = "mechanical_model";
   virtual ~MechanicalModel();
 
-  /// Names of the internal variables (each a scalar per particle, written to fields.h5).
-  virtual std::vector<std::string> internal_variables() const { return {}; }
+  /// The internal variables, each with its unit.
+  virtual std::vector<InternalVariable> internal_variables() const { return {}; }
   /// Their values before the first step.
   virtual std::vector<double> initial_state() const { return std::vector<double>(internal_variables().size(), 0.0); }
   virtual void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const = 0;

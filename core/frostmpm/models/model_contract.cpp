@@ -11,6 +11,7 @@
 #include <span>
 
 #include "frostmpm/config/input_error.hpp"
+#include "frostmpm/config/units.hpp"
 
 namespace frostmpm {
 
@@ -419,7 +420,13 @@ class MechanicalCheck {
   }
 
   void check_initial_state() {
-    names_ = model_.internal_variables();
+    names_.clear();
+    for (const auto& variable : model_.internal_variables()) {
+      names_.push_back(variable.name);
+      if (!units::is_output_unit(variable.unit))
+        v_.add("internal variable unit", "internal variable '" + variable.name + "' has the unit '" + variable.unit +
+                                             "'; give a UDUNITS-2 unit (\"1\" when dimensionless)");
+    }
     state0_ = model_.initial_state();
     if (state0_.size() != names_.size())
       v_.add("initial_state size", "initial_state() has " + std::to_string(state0_.size()) +

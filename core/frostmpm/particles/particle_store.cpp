@@ -1,5 +1,6 @@
 #include "frostmpm/particles/particle_store.hpp"
 
+#include "frostmpm/config/units.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 
 #include <algorithm>
@@ -25,26 +26,33 @@ std::vector<std::string> component_names(FieldKind kind, int components) {
   return names;
 }
 
-void ParticleStore::declare(const std::string& name, int components, double initial, FieldKind kind) {
+void ParticleStore::declare(const std::string& name, const std::string& unit, int components, double initial,
+                            FieldKind kind) {
+  if (!units::is_output_unit(unit))
+    throw std::logic_error("particle field '" + name + "' declared with the unit '" + unit +
+                           "'; give a UDUNITS-2 unit such as \"degC\", \"m/s\", or \"1\" when dimensionless");
   auto it = fields_.find(name);
   if (it != fields_.end()) {
     if (it->second.components != components)
       throw std::logic_error("particle field '" + name + "' declared with " + std::to_string(components) +
                              " and " + std::to_string(it->second.components) + " components");
+    if (it->second.unit != unit)
+      throw std::logic_error("particle field '" + name + "' declared in '" + unit + "' and in '" + it->second.unit + "'");
     if (it->second.kind == FieldKind::Other) it->second.kind = kind;
     return;
   }
   // Undeclared shapes: 1 component is a scalar, 2 or 3 a vector (x, y[, z]).
   if (kind == FieldKind::Other && components == 1) kind = FieldKind::Scalar;
   if (kind == FieldKind::Other && (components == 2 || components == 3)) kind = FieldKind::Vector;
-  Column column{components, initial, kind, false, std::vector<double>(size_ * components, initial)};
+  Column column{components, initial, kind, unit, false, std::vector<double>(size_ * components, initial)};
   fields_.emplace(name, std::move(column));
 }
 
-void ParticleStore::declare_history(const std::string& name, int components, double initial, FieldKind kind) {
-  declare(name, components, initial, kind);
+void ParticleStore::declare_history(const std::string& name, const std::string& unit, int components, double initial,
+                                    FieldKind kind) {
+  declare(name, unit, components, initial, kind);
   const std::string start = history_name(name);
-  declare(start, components, initial, kind);
+  declare(start, unit, components, initial, kind);
   fields_.at(start).internal = true;
   if (std::find(history_.begin(), history_.end(), name) == history_.end()) history_.push_back(name);
 }
@@ -69,6 +77,7 @@ const ParticleStore::Column& ParticleStore::find(const std::string& name) const 
 
 int ParticleStore::components(const std::string& name) const { return find(name).components; }
 FieldKind ParticleStore::kind(const std::string& name) const { return find(name).kind; }
+const std::string& ParticleStore::unit(const std::string& name) const { return find(name).unit; }
 bool ParticleStore::internal(const std::string& name) const { return find(name).internal; }
 
 std::span<double> ParticleStore::field(const std::string& name) { return column(name); }

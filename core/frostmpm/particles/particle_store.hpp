@@ -8,6 +8,9 @@
 // always 3×3, whatever the dimension (plane strain keeps σ_zz), as MOOSE's RankTwoTensor and
 // Uintah's Matrix3 do.
 //
+// Every field has a unit, given where it is declared (frostmpm/config/units.hpp): the output
+// writes it beside the values, and probes derive their columns' units from it.
+//
 // History: a field declared with history keeps a step-start copy that the kernel refreshes at
 // the start of every step, so a retried step or a rejected return mapping starts again from
 // the values the step began with (MOOSE's "old" material properties, Uintah's old data
@@ -51,12 +54,14 @@ struct ParticleRange {
 
 class ParticleStore {
  public:
-  /// Declares (or returns the existing) field; re-declaring with other components is an error.
-  /// The kind is taken from the first declaration that gives one other than Other.
-  void declare(const std::string& name, int components, double initial = 0.0, FieldKind kind = FieldKind::Other);
+  /// Declares (or returns the existing) field; re-declaring with other components or another
+  /// unit, or declaring without a valid unit (units::is_output_unit), is an error (std::logic_error). The
+  /// kind is taken from the first declaration that gives one other than Other.
+  void declare(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
+               FieldKind kind = FieldKind::Other);
   /// Declares a field with a step-start copy (see the header comment); the copy is the field
   /// history_name(name), internal (not offered to output or probes).
-  void declare_history(const std::string& name, int components, double initial = 0.0,
+  void declare_history(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
                        FieldKind kind = FieldKind::Other);
   static std::string history_name(const std::string& name) { return name + "__step_start"; }
   /// Copies every history field into its step-start copy (the kernel does it before each step).
@@ -64,6 +69,8 @@ class ParticleStore {
   bool has(const std::string& name) const { return fields_.count(name) != 0; }
   int components(const std::string& name) const;
   FieldKind kind(const std::string& name) const;
+  /// The unit it was declared with ("degC", "m/s", "1").
+  const std::string& unit(const std::string& name) const;
   /// True for the step-start copies of history fields.
   bool internal(const std::string& name) const;
 
@@ -88,6 +95,7 @@ class ParticleStore {
     int components = 1;
     double initial = 0;
     FieldKind kind = FieldKind::Other;
+    std::string unit;
     bool internal = false;
     std::vector<double> values;
   };

@@ -90,19 +90,22 @@ class Kernel {
   /// Contiguous runs of particles of one material (one per region): models are evaluated in
   /// batches over these, one virtual call per range.
   virtual const std::vector<ParticleRange>& particle_ranges() const = 0;
-  /// A particle field that regions may initialise with `initial: {name: value}`, in `unit` (a
-  /// UDUNITS-2 unit: "degC", "Pa", "m/s", "-"; a value given with another unit is converted);
-  /// an initial value of larger magnitude than `max_magnitude` is refused as a typo.
-  virtual void declare_state_field(const std::string& name, int components, double default_value,
-                                   const std::string& unit, double max_magnitude = std::numeric_limits<double>::infinity(),
+  // Every particle field is declared with its unit, UDUNITS-2 text ("degC", "Pa", "m/s", "1"
+  // when dimensionless; frostmpm/config/units.hpp): fields.h5 and the probes' columns carry it.
+  // Two physics that declare one field must agree on its components and unit.
+
+  /// A particle field that regions may initialise with `initial: {name: value}` (a value given
+  /// with another unit is converted to `unit`); an initial value of larger magnitude than `max_magnitude` is refused as a typo.
+  virtual void declare_state_field(const std::string& name, const std::string& unit, int components,
+                                   double default_value, double max_magnitude = std::numeric_limits<double>::infinity(),
                                    FieldKind kind = FieldKind::Other) = 0;
   /// A particle field the physics keeps (not set by regions).
-  virtual void declare_field(const std::string& name, int components, double initial = 0.0,
-                             FieldKind kind = FieldKind::Other) = 0;
+  virtual void declare_field(const std::string& name, const std::string& unit, int components = 1,
+                             double initial = 0.0, FieldKind kind = FieldKind::Other) = 0;
   /// A particle field with a step-start copy (ParticleStore::declare_history): a model or a
   /// retried step starts from the values the step began with.
-  virtual void declare_history(const std::string& name, int components, double initial = 0.0,
-                               FieldKind kind = FieldKind::Other) = 0;
+  virtual void declare_history(const std::string& name, const std::string& unit, int components = 1,
+                               double initial = 0.0, FieldKind kind = FieldKind::Other) = 0;
   /// Whether the scene has a particle field of this name (after every physics' setup).
   virtual bool has_particle_field(const std::string& name) const = 0;
   /// Sets a particle field to each particle's material parameter (before regions' `initial:`).

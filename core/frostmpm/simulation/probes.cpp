@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "frostmpm/config/param_schema.hpp"
+#include "frostmpm/config/units.hpp"
 
 namespace frostmpm {
 
@@ -26,10 +27,26 @@ int read_component(const ConfigNode& node, int dim) {
   throw node.error("unknown component '" + c + "'; valid: x, y" + std::string(dim == 3 ? ", z" : ""));
 }
 
+/// The unit of a product of quantities: their units side by side (UDUNITS reads a space as a
+/// product, "m/s m^3/m" as (m/s)·m³/m), dimensionless ones left out.
+std::string unit_product(const std::vector<std::string>& factors) {
+  std::string product;
+  for (const auto& unit : factors)
+    if (unit != "1") product += (product.empty() ? "" : " ") + unit;
+  return product.empty() ? "1" : product;
+}
+
+// The units of the geometric and force probes. A 2-D scene is a slice one metre thick: a force
+// on it is per metre of thickness.
+constexpr const char* kLengthUnit = "m";
+constexpr const char* kForceUnit = "N/m";
+constexpr const char* kPressureUnit = "Pa";
+
 }  // namespace
 
 struct Probes::Probe {
   std::string name, type, field;
+  std::string unit;  ///< of its column
   std::vector<std::string> fields;
   std::array<double, kDim> point{}, from{}, to{};
   double value = 0;
@@ -94,6 +111,11 @@ Probes::ScalarColumn Probes::scalar_column(const std::string& name) const {
   return {particles.field(name), 0, 1};
 }
 
+const std::string& Probes::scalar_unit(const std::string& name) const {
+  const auto& particles = *sources_.particles;
+  return particles.unit(particles.has(name) ? name : name.substr(0, name.rfind('.')));
+}
+
 void Probes::read(const ConfigNode* node, Sources sources) {
   sources_ = std::move(sources);
   resolved_ = YAML::Node(YAML::NodeType::Sequence);
@@ -147,14 +169,24 @@ void Probes::read(const ConfigNode* node, Sources sources) {
                                "'; valid: max, min (the extreme of the probe over the rows written so far)");
     }
     if (probe->type == "integral") {
-      for (const auto& f : item.child("fields").elements()) probe->fields.push_back(check_field(f));
+      std::vector<std::string> factors{sources_.particles->unit("volume")};
+      for (const auto& f : item.child("fields").elements()) {
+        probe->fields.push_back(check_field(f));
+        factors.insert(factors.end() - 1, scalar_unit(probe->fields.back()));
+      }
+      probe->unit = unit_product(factors);
       if (auto scale = item.optional_child("scale")) {
         probe->value = scale->as_real("-");
         if (!std::isfinite(probe->value)) throw scale->error("scale must be a finite number");
       } else {
         probe->value = 1.0;
       }
-      item.finish({"type", "name", "over_time", "fields", "scale"});
+      if (auto unit = item.optional_child("unit")) {  // a scale with a unit changes the column's
+        probe->unit = unit->as_string();
+        if (!units::is_output_unit(probe->unit))
+          throw unit->error("a unit is UDUNITS-2 text such as \"m/s\" or \"degC\" (\"1\" when dimensionless)");
+      }
+      item.finish({"type", "name", "over_time", "fields", "scale", "unit"});
     } else if (probe->type == "displacement") {
       const ConfigNode at = item.child("point");
       probe->point = read_inside(at);
@@ -169,6 +201,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       }
       probe->particles = {best};
       probe->start = {positions[best * kDim + probe->component]};
+      probe->unit = kLengthUnit;
       item.finish({"type", "name", "over_time", "point", "component"});
     } else if (probe->type == "settlement") {
       double x_lo = -std::numeric_limits<double>::infinity(), x_hi = std::numeric_limits<double>::infinity();
@@ -190,6 +223,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       }
       if (top.empty()) throw item.error("no particle lies within x_range");
       probe->component = kDim - 1;
+      probe->unit = kLengthUnit;
       // The surface is the top of these particles' domains: their centres sit half a particle
       // below it, and follow it only where the strain vanishes.
       for (const auto& [_, p] : top) {
@@ -209,6 +243,9 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         throw boundary.error("no boundary condition is named '" + probe->boundary + "'; named: " +
                              (names.empty() ? std::string("none (give one a name: key)") : join(names)));
       }
+      probe->unit = probe->type == "footing_pressure"       ? kPressureUnit
+                    : probe->type == "footing_displacement" ? kLengthUnit
+                                                            : kForceUnit;
       if (probe->type != "reaction") {
         if (!it->is_rigid_body)
           throw boundary.error("the " + it->label + " drives no rigid body; a " + probe->type +
@@ -228,6 +265,7 @@ void Probes::read(const ConfigNode* node, Sources sources) {
         throw type.error("a thaw_depth probe reads liquid_saturation, which only the thermal physics has; add "
                          "physics.thermal, or use an isotherm probe of another field");
       probe->field = "liquid_saturation";
+      probe->unit = kLengthUnit;
       probe->value = 0.5;
       if (auto level = item.optional_child("saturation")) {
         probe->value = level->as_real("-");
@@ -240,12 +278,12 @@ void Probes::read(const ConfigNode* node, Sources sources) {
       item.finish({"type", "name", "over_time", "saturation", "from", "to"});
     } else {
       probe->field = check_field(item.child("field"));
+      probe->unit = probe->type == "isotherm" ? kLengthUnit : scalar_unit(probe->field);
       if (probe->type == "value_at") {
         probe->point = read_inside(item.child("point"));
         item.finish({"type", "name", "over_time", "field", "point"});
       } else if (probe->type == "isotherm") {
-        const auto unit = sources_.field_units.find(probe->field);
-        probe->value = item.child("value").as_real(unit == sources_.field_units.end() ? "" : unit->second);
+        probe->value = item.child("value").as_real(scalar_unit(probe->field));
         probe->from = read_inside(item.child("from"));
         probe->to = read_inside(item.child("to"));
         item.finish({"type", "name", "over_time", "field", "value", "from", "to"});
@@ -293,8 +331,17 @@ std::vector<double> Probes::sample_line(const Probe& probe) const {
   return values;
 }
 
+namespace {
+/// The columns every metrics.csv starts with, and their units.
+const std::vector<std::pair<std::string, std::string>> kLeadingColumns = {{"time_s", "s"}, {"step", "1"}, {"dt_s", "s"}};
+}  // namespace
+
 const std::vector<std::string>& Probes::leading_columns() {
-  static const std::vector<std::string> columns = {"time_s", "step", "dt_s"};
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> names;
+    for (const auto& [name, unit] : kLeadingColumns) names.push_back(name);
+    return names;
+  }();
   return columns;
 }
 
@@ -302,6 +349,12 @@ std::string Probes::header() const {
   std::string header = join(leading_columns(), ",");
   for (const auto& probe : probes_) header += ',' + probe->name;
   return header;
+}
+
+std::vector<std::pair<std::string, std::string>> Probes::column_units() const {
+  auto units = kLeadingColumns;
+  for (const auto& probe : probes_) units.emplace_back(probe->name, probe->unit);
+  return units;
 }
 
 double Probes::sample_field(const std::string& field, const std::array<double, kDim>& point) const {

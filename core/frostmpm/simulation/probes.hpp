@@ -19,9 +19,11 @@
 //                    condition drives, named with `name:`), N per m in 2-D, positive resisting
 //   footing_pressure that force over the footing's contact area (width in 2-D), Pa
 //   footing_displacement  how far the footing has moved along its direction of motion, m
+// Every column has a unit (column_units(), run.json's metrics_units): a field's for min, max
+// and value_at; for an integral the fields' units times the volume's (m^3/m in 2-D), or its
+// `unit:` when a `scale` carries one; m, N/m or Pa for the geometric and force probes.
 #include <array>
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,9 +58,6 @@ class Probes {
     std::vector<std::string> reaction_types;  ///< types of the scene's conditions that have a reaction
     std::function<std::array<double, 3>(const std::string&)> reaction;
     std::function<Physics::RigidBodyMotion(const std::string&)> rigid_body;
-    /// The unit of fields whose values a scene may give (an isotherm's value); other fields
-    /// take bare numbers.
-    std::map<std::string, std::string> field_units;
   };
 
   Probes();
@@ -80,6 +79,8 @@ class Probes {
   void remove_particles(const ParticleRemoval& removal, double time);
   /// "time_s,step,dt_s,<probe names>".
   std::string header() const;
+  /// (column, unit) of every metrics.csv column, in header order.
+  std::vector<std::pair<std::string, std::string>> column_units() const;
   /// The columns metrics.csv has before the probes' (no probe may take these names).
   static const std::vector<std::string>& leading_columns();
   YAML::Node resolved() const { return resolved_; }
@@ -96,6 +97,8 @@ class Probes {
     std::size_t component = 0, stride = 1;
   };
   ScalarColumn scalar_column(const std::string& name) const;
+  /// The unit of a scalar name: its field's, for a component ("stress.yy") the tensor's.
+  const std::string& scalar_unit(const std::string& name) const;
   /// Every scalar name a probe may use: scalar fields and the components of the others.
   std::vector<std::string> scalar_names() const;
 

@@ -359,9 +359,10 @@ void Simulation::read_regions(const ConfigNode& node) {
         points[r].push_back(x);
         break;
       }
-  particles_.declare("position", kDim, 0.0, FieldKind::Vector);
-  particles_.declare("volume", 1);
-  particles_.declare("half_size", kDim, 0.0, FieldKind::Vector);
+  particles_.declare("position", "m", kDim, 0.0, FieldKind::Vector);
+  // A 2-D particle stands for a prism one metre thick: its volume is per metre of thickness.
+  particles_.declare("volume", "m^3/m");
+  particles_.declare("half_size", "m", kDim, 0.0, FieldKind::Vector);
   const double volume = grid_.cell_volume() / std::pow(ppc, kDim);
   const auto lo = grid_.origin, hi = grid_.upper();
   for (std::size_t r = 0; r < regions.size(); ++r) {
@@ -391,7 +392,7 @@ void Simulation::read_regions(const ConfigNode& node) {
   transfer_.set_materials(std::move(material));
   if (leaving_ == LeavingPolicy::Remove) {
     // Removal renumbers particles: each keeps the index the scene gave it, for output and restarts.
-    particles_.declare("particle_id", 1, 0.0, FieldKind::Scalar);
+    particles_.declare("particle_id", "1", 1, 0.0, FieldKind::Scalar);
     auto id = particles_.field("particle_id");
     for (std::size_t p = 0; p < id.size(); ++p) id[p] = static_cast<double>(p);
   }

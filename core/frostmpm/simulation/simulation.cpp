@@ -93,7 +93,6 @@ Simulation::Simulation(const Registry& registry, const ConfigNode& root) : regis
     }
     sources.reaction = [this](const std::string& name) { return reaction(name); };
     sources.rigid_body = [this](const std::string& name) { return rigid_body(name); };
-    sources.field_units = state_units_;
     const auto probes = root.optional_child("probes");
     probes_.read(probes ? &*probes : nullptr, std::move(sources));
     resolved_["probes"] = probes_.resolved();
@@ -161,22 +160,21 @@ std::vector<BoundaryCondition*> Simulation::boundary_conditions(const std::strin
   return out;
 }
 
-void Simulation::declare_state_field(const std::string& name, int components, double default_value,
-                                     const std::string& unit, double max_magnitude, FieldKind kind) {
-  if (const auto it = state_units_.find(name); it != state_units_.end() && it->second != unit)
-    throw std::logic_error("state field '" + name + "' declared in " + it->second + " and in " + unit);
-  state_units_[name] = unit;
+void Simulation::declare_state_field(const std::string& name, const std::string& unit, int components,
+                                     double default_value, double max_magnitude, FieldKind kind) {
   state_bounds_[name] = max_magnitude;
-  particles_.declare(name, components, default_value, kind);
+  particles_.declare(name, unit, components, default_value, kind);
   state_defaults_[name] = default_value;
 }
 
-void Simulation::declare_field(const std::string& name, int components, double initial, FieldKind kind) {
-  particles_.declare(name, components, initial, kind);
+void Simulation::declare_field(const std::string& name, const std::string& unit, int components, double initial,
+                               FieldKind kind) {
+  particles_.declare(name, unit, components, initial, kind);
 }
 
-void Simulation::declare_history(const std::string& name, int components, double initial, FieldKind kind) {
-  particles_.declare_history(name, components, initial, kind);
+void Simulation::declare_history(const std::string& name, const std::string& unit, int components, double initial,
+                                 FieldKind kind) {
+  particles_.declare_history(name, unit, components, initial, kind);
 }
 
 void Simulation::fill_from_materials(const std::string& field, const std::string& parameter) {
@@ -229,15 +227,15 @@ void Simulation::resolve_step() {
   for (std::size_t i = 0; i < physics_.size(); ++i)
     for (auto& stage : physics_[i]->stages()) declared.push_back({std::move(stage), physics_keys_[i], physics_where_[i]});
   plan_ = StepPlan::resolve(std::move(declared), particles_.field_names());
-  for (const auto& f : plan_.new_particle_fields()) particles_.declare(f.name, f.components, 0.0, f.kind);
+  for (const auto& f : plan_.new_particle_fields()) particles_.declare(f.name, f.unit, f.components, 0.0, f.kind);
   for (const auto& f : plan_.node_fields()) node_fields_.allocate(f.name, f.components, grid_.node_count());
   // Particles move when a stage writes their positions: the kernel then keeps their geometry.
   for (const auto& stage : plan_.stages())
     for (const auto& f : stage.writes)
       if (f.location == FieldLocation::Particle && f.name == "position") moving_ = true;
   if (moving_) {
-    particles_.declare(kInitialVolume, 1);
-    particles_.declare(kInitialHalfSize, kDim, 0.0, FieldKind::Vector);
+    particles_.declare(kInitialVolume, particles_.unit("volume"));
+    particles_.declare(kInitialHalfSize, "m", kDim, 0.0, FieldKind::Vector);
     const auto V = particles_.field("volume"), half = particles_.field("half_size");
     auto V0 = particles_.field(kInitialVolume), half0 = particles_.field(kInitialHalfSize);
     std::copy(V.begin(), V.end(), V0.begin());
@@ -437,7 +435,7 @@ void Simulation::apply_initial_values() {
         count = particles_.components(field);
       }
       const ParamSpec* spec = material_schema_.find(field);
-      const std::string& unit = state_units_.at(field);
+      const std::string& unit = particles_.unit(field);
       // What is wrong with a value ("is not a finite number"), empty when it is fine.
       auto problem = [&](double value) -> std::string {
         if (!std::isfinite(value)) return "is not a finite number";
@@ -871,7 +869,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   auto write_frame = [&] {
     std::vector<FieldView> views;
     for (const auto& name : output_fields_)
-      views.push_back({name, particles_.field(name).data(), particles_.components(name)});
+      views.push_back({name, particles_.field(name).data(), particles_.components(name), particles_.unit(name)});
     writer.write(time_, step_, particles_.size(), particles_.field("position").data(), views);
   };
   auto write_metrics = [&] {

@@ -90,12 +90,12 @@ class Simulation final : public Kernel<kDim> {
   std::vector<std::string> physics_names() const override { return physics_keys_; }
   std::size_t particle_count() const override { return particles_.size(); }
   const std::vector<ParticleRange>& particle_ranges() const override { return particles_.ranges(); }
-  void declare_state_field(const std::string& name, int components, double default_value,
-                           const std::string& unit, double max_magnitude = std::numeric_limits<double>::infinity(),
+  void declare_state_field(const std::string& name, const std::string& unit, int components, double default_value,
+                           double max_magnitude = std::numeric_limits<double>::infinity(),
                            FieldKind kind = FieldKind::Other) override;
-  void declare_field(const std::string& name, int components, double initial = 0.0,
+  void declare_field(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
                      FieldKind kind = FieldKind::Other) override;
-  void declare_history(const std::string& name, int components, double initial = 0.0,
+  void declare_history(const std::string& name, const std::string& unit, int components = 1, double initial = 0.0,
                        FieldKind kind = FieldKind::Other) override;
   bool has_particle_field(const std::string& name) const override { return particles_.has(name); }
   void fill_from_materials(const std::string& field, const std::string& parameter) override;
@@ -119,6 +119,8 @@ class Simulation final : public Kernel<kDim> {
   long restarts() const { return restarts_; }
   const std::vector<std::shared_ptr<Physics>>& physics() const { return physics_; }
   bool particles_move() const override { return moving_; }
+  /// (column, unit) of every metrics.csv column, in its order.
+  std::vector<std::pair<std::string, std::string>> metrics_units() const { return probes_.column_units(); }
   /// Particles removed after leaving the grid (grid.particles_leaving: remove).
   long removed_particles() const { return static_cast<long>(initial_particles_ - particles_.size()); }
 
@@ -202,7 +204,6 @@ class Simulation final : public Kernel<kDim> {
   std::vector<std::string> output_fields_;
   std::map<std::string, double> state_defaults_;
   std::map<std::string, double> state_bounds_;  ///< largest plausible |initial value| per field
-  std::map<std::string, std::string> state_units_;  ///< the unit of each state field's values
   ParamSchema material_schema_;  ///< every physics' material keys; also bounds `initial:` values
   ParamSet time_params_;
   long max_steps_ = 0;

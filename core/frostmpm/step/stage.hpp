@@ -54,13 +54,19 @@ struct FieldRef {
   /// The physics' handle the kernel binds to this field's storage (none: declaration only).
   FieldHandle* handle = nullptr;
   FieldKind kind = FieldKind::Other;
+  /// For a particle field no physics declares in setup(), which the kernel creates because a
+  /// stage writes it: its unit ("m/s", "1"; frostmpm/config/units.hpp). A writer must give it.
+  std::string unit;
 
   std::string describe() const;  ///< "particle field 'temperature'", "node field 'liquid_velocity'"
   bool same_field(const FieldRef& other) const { return location == other.location && name == other.name; }
 };
 
-inline FieldRef particle_field(std::string name, int components = 1) {
-  return {FieldLocation::Particle, std::move(name), components, false};
+/// `unit`: see FieldRef::unit.
+inline FieldRef particle_field(std::string name, int components = 1, std::string unit = {}) {
+  FieldRef f{FieldLocation::Particle, std::move(name), components, false};
+  f.unit = std::move(unit);
+  return f;
 }
 inline FieldRef node_field(std::string name, int components = 1) {
   return {FieldLocation::Node, std::move(name), components, false};
@@ -81,10 +87,13 @@ inline FieldRef carried_node_field(std::string name, int components = 1) {
 class FieldHandle {
  public:
   FieldHandle() = default;
-  FieldHandle(FieldLocation location, std::string name, int components = 1, FieldKind kind = FieldKind::Other)
-      : location_(location), name_(std::move(name)), components_(components), kind_(kind) {}
-  static FieldHandle particle(std::string name, int components = 1, FieldKind kind = FieldKind::Other) {
-    return {FieldLocation::Particle, std::move(name), components, kind};
+  FieldHandle(FieldLocation location, std::string name, int components = 1, FieldKind kind = FieldKind::Other,
+              std::string unit = {})
+      : location_(location), name_(std::move(name)), components_(components), kind_(kind), unit_(std::move(unit)) {}
+  /// `unit`: see FieldRef::unit (a field some physics declares in setup() needs none here).
+  static FieldHandle particle(std::string name, int components = 1, FieldKind kind = FieldKind::Other,
+                              std::string unit = {}) {
+    return {FieldLocation::Particle, std::move(name), components, kind, std::move(unit)};
   }
   static FieldHandle node(std::string name, int components = 1, FieldKind kind = FieldKind::Other) {
     return {FieldLocation::Node, std::move(name), components, kind};
@@ -125,8 +134,7 @@ class FieldHandle {
 
  private:
   FieldRef ref(bool optional, bool carried) {
-    FieldRef f{location_, name_, components_, carried, optional, this, kind_};
-    return f;
+    return FieldRef{location_, name_, components_, carried, optional, this, kind_, unit_};
   }
   std::span<double> storage() const;
 
@@ -134,6 +142,7 @@ class FieldHandle {
   std::string name_;
   int components_ = 1;
   FieldKind kind_ = FieldKind::Other;
+  std::string unit_;
   std::vector<double>* column_ = nullptr;
   bool writable_ = false;
 };

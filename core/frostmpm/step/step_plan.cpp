@@ -97,8 +97,9 @@ std::vector<std::size_t> order_phase(const std::vector<StepPlan::Declared>& all,
 }  // namespace
 
 StepPlan StepPlan::resolve(std::vector<Declared> declared, const std::vector<std::string>& particle_fields) {
-  // Field shapes agree wherever a field is named.
+  // Field shapes and the units given agree wherever a field is named.
   std::map<std::string, std::pair<int, std::string>> shape;  // key → components, first stage naming it
+  std::map<std::string, std::pair<std::string, std::string>> unit;  // key → unit, first stage giving it
   std::set<std::string> carried;
   for (const auto& d : declared)
     for (const auto* list : {&d.stage.reads, &d.stage.writes})
@@ -108,6 +109,12 @@ StepPlan StepPlan::resolve(std::vector<Declared> declared, const std::vector<std
           throw InputError(d.where, "stage '" + d.stage.name + "' declares " + f.describe() + " with " +
                                         std::to_string(f.components) + " components, stage '" + it->second.second +
                                         "' with " + std::to_string(it->second.first));
+        if (!f.unit.empty()) {
+          const auto [u, first] = unit.try_emplace(key(f), f.unit, d.stage.name);
+          if (!first && u->second.first != f.unit)
+            throw InputError(d.where, "stage '" + d.stage.name + "' declares " + f.describe() + " in '" + f.unit +
+                                          "', stage '" + u->second.second + "' in '" + u->second.first + "'");
+        }
         if (list == &d.stage.writes && f.carried) carried.insert(key(f));
       }
 
@@ -185,8 +192,18 @@ StepPlan StepPlan::resolve(std::vector<Declared> declared, const std::vector<std
         if (!listed.insert(key(f)).second) continue;
         FieldRef g = f;
         g.carried = carried.count(key(f)) != 0;
-        if (f.location == FieldLocation::Node) plan.node_fields_.push_back(g);
-        else if (!state.count(f.name)) plan.new_particle_fields_.push_back(g);
+        if (f.location == FieldLocation::Node) {
+          plan.node_fields_.push_back(g);
+        } else if (!state.count(f.name)) {  // the first naming of a new field is its first write
+          const auto u = unit.find(key(f));
+          if (u == unit.end())
+            throw InputError(declared[i].where,
+                             "stage '" + declared[i].stage.name + "' writes " + f.describe() +
+                                 ", which no physics declares in setup(), and gives no unit for it: declare it there "
+                                 "(declare_field(name, unit, ...)) or give the handle of its writer a unit");
+          g.unit = u->second.first;
+          plan.new_particle_fields_.push_back(g);
+        }
       }
     plan.physics_.push_back(declared[i].physics);
     plan.stages_.push_back(std::move(declared[i].stage));

@@ -6,8 +6,9 @@
 // stages that write it (ties keep the order of the physics in the scene, then of their stages;
 // two writers of one field keep that order too). Checks: every field a stage reads is written
 // by an earlier stage, or is state carried from the last step (a particle field the scene has,
-// or a nodal field its writer marks carried); one field has one component count; the order
-// has no cycle. A failed check is one InputError naming the stage, the field and the physics
+// or a nodal field its writer marks carried); one field has one component count (and one unit,
+// where stages give one); a particle field only a stage creates has a unit; the order has no
+// cycle. A failed check is one InputError naming the stage, the field and the physics
 // section.
 #include <string>
 #include <vector>
@@ -34,7 +35,8 @@ class StepPlan {
   std::vector<Stage>& stages() { return stages_; }
   /// Nodal fields some stage reads or writes (name, components, carried), by name.
   const std::vector<FieldRef>& node_fields() const { return node_fields_; }
-  /// Particle fields a stage writes that did not exist before: the kernel declares them.
+  /// Particle fields a stage writes that did not exist before, with the unit a stage gave: the
+  /// kernel declares them.
   const std::vector<FieldRef>& new_particle_fields() const { return new_particle_fields_; }
 
   /// The step as `frostmpm check` prints it: phase, stage, reads, writes, skipped phases.

@@ -23,6 +23,7 @@ class GridSampler final : public Physics {
   static ParamSchema schema() {
     ParamSchema s;
     s.string("field", "nodal field to sample").defaults_to("temperature");
+    s.string("unit", "its unit, which the sampled particle field carries").defaults_to("degC");
     s.choice("phase", {"map_to_grid", "energy", "map_to_particles", "update_materials"}, "phase the stage joins")
         .defaults_to("update_materials");
     return s;
@@ -31,7 +32,7 @@ class GridSampler final : public Physics {
       : field_(p.string("field")),
         phase_(p.string("phase")),
         nodal_(FieldHandle::node(field_)),
-        sampled_(FieldHandle::particle(field_ + "_sampled")) {}
+        sampled_(FieldHandle::particle(field_ + "_sampled", 1, FieldKind::Scalar, p.string("unit"))) {}
 
   ParamSchema material_schema() const override { return {}; }
   std::vector<ModelSlot> material_models() const override { return {}; }
