@@ -5,6 +5,7 @@
     /usr/bin/python3 scripts/plot_verification.py mandel OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py prandtl OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py reissner OUT [OUT ...] [--png FILE]
+    /usr/bin/python3 scripts/plot_verification.py granular OUT [OUT ...] [--png FILE]
 
 terzaghi: configs/verification/terzaghi_consolidation.yaml runs (any cell sizes): the degree of
 consolidation U = settlement / (q H / E_oed) and the base pore pressure against Terzaghi's series
@@ -13,7 +14,10 @@ centre against Mandel's series for ν = 0.3 (T = t / 50 s), with the Mandel–Cr
 prandtl: configs/verification/prandtl_footing.yaml runs: the footing pressure over (2 + π) c
 against the settlement in cells, labelled with the cell size and `volumetric_strain`. reissner:
 configs/verification/reissner_footing.yaml runs: the footing pressure over c N_c + q0 N_q
-(φ = 20°) against the settlement in mm, with the window the test averages.
+(φ = 20°) against the settlement in mm, with the window the test averages. granular:
+configs/verification/granular_collapse.yaml runs (any aspect ratio): one panel each, the final
+deposit's particles coloured by their plastic deviatoric strain over the column's outline, and
+the band of runouts the experiments give (Lube et al. 2005, ±20 %).
 Each OUT is a run folder; the legend shows its cell size from run.json.
 """
 import argparse
@@ -118,15 +122,68 @@ def reissner(folders, png):
                    "Prandtl–Reissner footing: c = 10 kPa, φ = ψ = 20°, q0 = 10 kPa")
 
 
+def lube_band(aspect):
+    """Runout (L∞ − L0)/L0 of Lube et al. (2005), ±20 %; between their two fits, both."""
+    fits = [1.2 * aspect] if aspect < 1.8 else [1.9 * aspect ** (2 / 3)] if aspect > 2.8 else \
+        [1.2 * aspect, 1.9 * aspect ** (2 / 3)]
+    return 0.8 * min(fits), 1.2 * max(fits)
+
+
+def deposit_toe(x, bin_width=0.005):
+    """Where the deposit's surface meets the base, as tests/verification/test_granular_collapse.cpp
+    reads it: the top of the particles in 5 mm columns between 10 % and 50 % of the deposit's
+    height beyond its highest column, fitted by a line and extended to zero height. (toe, line)"""
+    bins = (x[:, 0] / bin_width).astype(int)
+    top = np.zeros(bins.max() + 1)
+    np.maximum.at(top, bins, x[:, 1])
+    centres = (np.arange(top.size) + 0.5) * bin_width
+    beyond = np.arange(top.size) > np.argmax(top)
+    used = beyond & (top > 0.1 * top.max()) & (top < 0.5 * top.max())
+    slope, intercept = np.polyfit(centres[used], top[used], 1)
+    return -intercept / slope, (slope, intercept)
+
+
+def granular(folders, png):
+    runs = []
+    for folder in folders:
+        frames = frostplot.read_fields.read_frames(folder)
+        x0 = frames[0]["coordinates"]
+        width, height = x0[:, 0].max() + x0[:, 0].min(), x0[:, 1].max() + x0[:, 1].min()
+        runs.append((folder, frames[-1], width, height))
+    reach = max(1 + 1.1 * lube_band(h / w)[1] for _, _, w, h in runs)
+    fig, axes = plt.subplots(len(runs), 1, figsize=(8, 1.6 * sum(h / w for _, _, w, h in runs) + 1.6 * len(runs)),
+                             gridspec_kw={"height_ratios": [h / w for _, _, w, h in runs]}, squeeze=False)
+    for ax, (folder, last, width, height) in zip(axes[:, 0], runs):
+        x, aspect = last["coordinates"], height / width
+        strain = last["fields"]["plastic_deviatoric_strain"]
+        dots = ax.scatter(x[:, 0] / width, x[:, 1] / width, c=np.clip(strain, 0, 2), s=1.5, cmap="viridis", vmin=0, vmax=2)
+        ax.plot([0, 1, 1], [aspect, aspect, 0], "k--", lw=0.8, label="the column at t = 0")
+        toe, (slope, intercept) = deposit_toe(x[:, :2])
+        ax.plot([toe / width - 0.5 * aspect, toe / width], [-0.5 * aspect * slope, 0], "r-", lw=1,
+                label=f"surface extended: runout {(toe - width) / width:.2f}")
+        low, high = lube_band(aspect)
+        ax.axvspan(1 + low, 1 + high, color="0.85", zorder=0, label="Lube et al. (2005) ±20 %")
+        ax.set(aspect="equal", xlim=(0, reach), ylim=(0, aspect * 1.05))
+        ax.set_title(f"a = {aspect:g}, t = {last['time']:g} s, {cell_label(folder)}", fontsize=9)
+        ax.set_ylabel("y / L0")
+        ax.legend(fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("x / L0")
+    fig.colorbar(dots, ax=axes[:, 0].tolist(), orientation="horizontal", fraction=0.05, pad=0.12,
+                 label="plastic deviatoric strain (clipped at 2)")
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl", "reissner"])
+    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl", "reissner", "granular"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png)")
     args = parser.parse_args()
     png = args.png or f"{args.figure}.png"
-    {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl, "reissner": reissner}[args.figure](args.folders, png)
+    {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl, "reissner": reissner,
+     "granular": granular}[args.figure](args.folders, png)
     print(f"wrote {png}")
 
 

@@ -8,6 +8,8 @@
 //        faces (area: their extent across the normal), following the material as it moves
 //   {type: rigid_plate, nodes: {face: y_max}, force: F(t)}  a rigid frictionless plate carrying
 //                                                   the total force F [N, per m in 2-D] (Mandel)
+//   {type: friction, nodes: {face: y_min}, friction_angle: δ}   a rigid wall on a grid face the
+//        material may leave but not cross, sliding along it against Coulomb friction μ = tan δ
 //   {type: footing, nodes: {box: ...}, y: v(t), contact: rough|smooth}  a rigid footing driven
 //        at a prescribed velocity along one axis: the nodes inside its box, which moves with it,
 //        follow it (rough: the other components held at 0); footing_* probes report it
@@ -160,6 +162,22 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
       owner = plate_owner(plates_.size());
     }
     plates_.push_back(std::move(c));
+  }
+  for (auto* bc : kernel.boundary_conditions("friction")) {
+    bc->accept_keys({"friction_angle"});
+    on_nodes(bc);
+    if (bc->face_axis < 0) throw bc->node->error("a friction wall lies on a grid face: use nodes: {face: ...}");
+    const ConfigNode angle = bc->node->child("friction_angle");
+    const double delta = angle.as_real("degree");
+    if (!(delta >= 0 && delta < 90))
+      throw angle.error("the wall's friction angle δ must lie in [0, 90) degrees (0: smooth; μ = tan δ)");
+    FrictionCondition c;
+    c.bc = bc;
+    c.nodes = bc->nodes;
+    c.axis = bc->face_axis;
+    c.side = bc->face_side;
+    c.coefficient = std::tan(delta * M_PI / 180.0);
+    friction_bcs_.push_back(std::move(c));
   }
   for (auto* bc : kernel.boundary_conditions("footing")) read_footing(*bc, kernel);
   place_footings();
@@ -394,6 +412,36 @@ void MechanicalPhysics<Dim>::constrain(std::vector<double>& v, double t, double 
       }
     }
   }
+  apply_friction(v, force_scale);
+}
+
+/// Coulomb friction on the walls, after the velocity conditions: a node moving into its wall
+/// stops along the normal, the normal velocity change Δv_n ≥ 0 being the impulse the wall gives
+/// per mass, and its tangential velocity shrinks by at most μ Δv_n (to zero: sticking). A node
+/// moving away is left alone (the wall pulls nothing). Components a velocity condition holds
+/// keep their value; the force is the impulse over the step, as constrain()'s reactions.
+template <int Dim>
+void MechanicalPhysics<Dim>::apply_friction(std::vector<double>& v, double force_scale) {
+  for (auto& c : friction_bcs_) {
+    for (std::size_t i : c.nodes) {
+      if (mass_[i] <= 0 || constraint_owner_[i * Dim + c.axis] != kFree) continue;
+      double* vi = v.data() + i * Dim;
+      const double into = vi[c.axis] * c.side;  // > 0: towards the wall
+      if (into <= 0) continue;
+      double tangential2 = 0;
+      for (int d = 0; d < Dim; ++d)
+        if (d != c.axis && constraint_owner_[i * Dim + d] == kFree) tangential2 += vi[d] * vi[d];
+      const double tangential = std::sqrt(tangential2);
+      const double keep = tangential > 0 ? std::max(0.0, 1.0 - c.coefficient * into / tangential) : 0.0;
+      const double m = (mass_[i] + dt_ * drag_[i]) / dt_;
+      for (int d = 0; d < Dim; ++d) {
+        if (d != c.axis && constraint_owner_[i * Dim + d] != kFree) continue;
+        const double now = d == c.axis ? 0.0 : keep * vi[d];
+        if (force_scale > 0) c.reaction[d] += force_scale * m * (now - vi[d]);
+        vi[d] = now;
+      }
+    }
+  }
 }
 
 template <int Dim>
@@ -426,6 +474,8 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
     if (c.bc == &bc) return c.reaction;
   for (const auto& c : traction_bcs_)
     if (c.bc == &bc) return c.applied;
+  for (const auto& c : friction_bcs_)
+    if (c.bc == &bc) return c.reaction;
   return std::nullopt;
 }
 
@@ -436,6 +486,7 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
   template int MechanicalPhysics<D>::particle_normal_axis(const BoundaryCondition&);               \
   template void MechanicalPhysics<D>::constrain(std::vector<double>&, double, double);             \
   template void MechanicalPhysics<D>::tie_plates(std::vector<double>&, double, double, bool);      \
+  template void MechanicalPhysics<D>::apply_friction(std::vector<double>&, double);                \
   template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const; \
   template void MechanicalPhysics<D>::read_footing(BoundaryCondition&, const Kernel<D>&);                 \
   template void MechanicalPhysics<D>::place_footings();                                                     \

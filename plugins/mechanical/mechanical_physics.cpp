@@ -808,6 +808,7 @@ void MechanicalPhysics<Dim>::predict() {
                                               : vn[i * Dim + d];
   });
   for (auto& c : velocity_bcs_) c.reaction = {};
+  for (auto& c : friction_bcs_) c.reaction = {};
   tie_plates(v_star, time_, dt_, true);
   // Cundall's local damping: a force against the motion, a fraction α of the unbalanced force —
   // the net force of the step (internal, body, traction, plate load and drag), m Δv*/Δt. Only on

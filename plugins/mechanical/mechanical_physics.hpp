@@ -44,7 +44,7 @@ class MechanicalPhysics final : public Physics {
     return {{"mechanical_model", MechanicalModel::kKind, true}};
   }
   std::vector<std::string> boundary_types() const override {
-    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate", "footing"};
+    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate", "footing", "friction"};
   }
 
   void setup(Kernel<Dim>& kernel) override;
@@ -65,6 +65,17 @@ class MechanicalPhysics final : public Physics {
     const BoundaryCondition* bc = nullptr;
     std::vector<std::size_t> nodes;
     std::array<std::optional<TimeFunction>, Dim> value;
+    std::array<double, 3> reaction{};  ///< force on the material over the last step [N (per m in 2-D)]
+  };
+  /// A rigid wall along a grid face with Coulomb friction (`type: friction`): the material may
+  /// leave it but not cross it, and slides along it only while the tangential force it needs
+  /// exceeds μ times the normal force it presses with (μ = tan δ).
+  struct FrictionCondition {
+    const BoundaryCondition* bc = nullptr;
+    std::vector<std::size_t> nodes;
+    int axis = 0;                      ///< the face's normal axis
+    int side = -1;                     ///< the face's outward normal: −1 on a min face, +1 on a max face
+    double coefficient = 0;            ///< μ = tan δ
     std::array<double, 3> reaction{};  ///< force on the material over the last step [N (per m in 2-D)]
   };
   /// A traction condition: force per area on face nodes, or on the surface of a set of
@@ -117,6 +128,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<MaterialData> materials_;
   std::vector<VelocityCondition> velocity_bcs_;
   std::vector<TractionCondition> traction_bcs_;
+  std::vector<FrictionCondition> friction_bcs_;
   std::vector<PlateCondition> plates_;
   std::vector<FootingCondition> footings_;
   double footing_limit_ = std::numeric_limits<double>::infinity();  ///< h / the fastest footing speed of the run [s]
@@ -159,6 +171,7 @@ class MechanicalPhysics final : public Physics {
   /// Sets the prescribed components of the nodal velocity `v` at time t; with `force_scale` > 0
   /// adds each condition's reaction (force_scale · (v_prescribed − v_free) per component).
   void constrain(std::vector<double>& v, double t, double force_scale);
+  void apply_friction(std::vector<double>& v, double force_scale);
   /// Gives every plate's nodes one normal velocity, momentum-weighted with the nodal inertia
   /// m (+ Δt D when `with_drag`), plus `dt` times the plate's load at time t.
   void tie_plates(std::vector<double>& v, double t, double dt, bool with_drag);

@@ -21,7 +21,8 @@ const std::map<std::string, std::string> kScenes = {
     {"SW", "configs/verification/self_weight_column.yaml"}, {"VB", "configs/verification/vibrating_bar.yaml"},
     {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"},
     {"RF", "configs/paper/rock_freezing.yaml"},          {"PF", "configs/verification/prandtl_footing.yaml"},
-    {"RS", "configs/verification/reissner_footing.yaml"}, {"IS", "configs/verification/infinite_slope.yaml"}};
+    {"RS", "configs/verification/reissner_footing.yaml"}, {"IS", "configs/verification/infinite_slope.yaml"},
+    {"GC", "configs/verification/granular_collapse.yaml"}};
 
 struct Case {
   int line = 0;
