@@ -304,7 +304,7 @@ int main(int argc, char** argv) {
   bool markdown = false;
   std::vector<std::string> describe_paths;
   auto* describe = cli.add_subcommand("describe", "show a model's parameters: units, defaults, ranges, docs");
-  describe->add_option("target", describe_target, "KIND/NAME (e.g. sfcc/exponential), KIND, or 'all'")
+  describe->add_option("target", describe_target, "KIND/NAME (e.g. sfcc/exponential), KIND, a kernel section (grid, time, output, checkpoint), or 'all'")
       ->required();
   describe->add_flag("--markdown", markdown, "print Markdown (used to generate docs/config-reference.md)");
   describe->add_option("--plugin-path", describe_paths, "extra plugin folder or library (repeatable)")

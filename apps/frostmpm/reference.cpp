@@ -25,14 +25,11 @@ std::string scene_form(const RegistryEntry& e) {
   return "{model: " + e.name + (e.schema.params().empty() ? "}" : ", ...}");
 }
 
-void describe_text(const RegistryEntry& e, std::ostream& out) {
-  out << e.kind << "/" << e.name << " — " << e.doc << "\n";
-  out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
-  out << "  YAML: " << scene_form(e) << "\n";
-  // One row per parameter: name, type, unit, default, allowed range, doc; the columns as wide
-  // as their widest entry (UTF-8 aware: units like °C), two spaces apart.
+/// One row per parameter: name, type, unit, default, allowed range, doc; the columns as wide
+/// as their widest entry (UTF-8 aware: units like °C), two spaces apart.
+void parameter_table(const ParamSchema& schema, std::ostream& out) {
   std::vector<std::array<std::string, 6>> rows;
-  for (const auto& p : e.schema.params())
+  for (const auto& p : schema.params())
     rows.push_back({p.name, to_string(p.type), p.unit.empty() ? "-" : p.unit, p.default_text(),
                     p.type == ParamType::Choice ? "one of: " + join(p.choices) : p.range_text(), p.doc});
   const auto width = [](const std::string& s) {
@@ -48,6 +45,13 @@ void describe_text(const RegistryEntry& e, std::ostream& out) {
   }
 }
 
+void describe_text(const RegistryEntry& e, std::ostream& out) {
+  out << e.kind << "/" << e.name << " — " << e.doc << "\n";
+  out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
+  out << "  YAML: " << scene_form(e) << "\n";
+  parameter_table(e.schema, out);
+}
+
 void describe_markdown(const RegistryEntry& e, std::ostream& out) {
   out << "### `" << e.kind << "/" << e.name << "`\n\n" << e.doc << ".\n\n";
   out << "Plugin `" << e.plugin << "`. Scene form: `" << scene_form(e) << "`.\n\n";
@@ -58,6 +62,12 @@ void describe_markdown(const RegistryEntry& e, std::ostream& out) {
         << " | " << p.default_text() << " | " << (range.empty() ? "any" : range) << " | " << p.doc << " |\n";
   }
   out << "\n";
+}
+
+std::vector<std::string> described_sections() {
+  std::vector<std::string> names;
+  for (const auto& [name, schema] : Simulation::section_schemas()) names.push_back(name);
+  return names;
 }
 
 }  // namespace
@@ -83,11 +93,19 @@ int cmd_describe(const std::string& target, bool markdown, const std::vector<std
   // A kind nobody registered is a typo or a scene section, not a missing plugin: say which.
   if (const std::string kind = target.substr(0, slash); target != "all" && registry.entries(kind).empty()) {
     const auto kinds = registry.kinds();
+    // The kernel's own sections with a fixed set of keys are described like a model.
+    for (const auto& [name, schema] : Simulation::section_schemas())
+      if (target == name) {
+        out << name << " — a scene section the kernel reads\n  YAML: " << name << ": {...}\n";
+        parameter_table(schema, out);
+        return 0;
+      }
     const auto sections = Simulation::sections();  // `physics` is also a kind, found above
     if (std::find(sections.begin(), sections.end(), kind) != sections.end())
-      throw InputError("describe: '" + kind + "' is a scene section the kernel reads, not a plugin kind: "
-                       "docs/config-reference.md lists its keys, and `frostmpm check SCENE` prints them with their "
-                       "defaults. Plugin kinds: " + join(kinds));
+      throw InputError("describe: '" + kind + "' is a scene section whose keys depend on the physics and "
+                       "models a scene names: docs/config-reference.md and docs/user-guide.md list them, and `frostmpm check SCENE` "
+                       "prints a scene's with their defaults. Described here: " + join(described_sections()) +
+                       "; plugin kinds: " + join(kinds));
     throw InputError("describe: unknown kind '" + kind + "'" + did_you_mean(kind, kinds) + " Kinds: " + join(kinds));
   }
   if (target == "all") {

@@ -414,11 +414,27 @@ TEST_CASE("describe: a mistyped kind gets a suggestion, a kernel section says wh
   CHECK(r.exit_code == 2);
   CHECK(r.output.find("unknown kind 'sfc'; did you mean 'sfcc'?") != std::string::npos);
   CHECK(r.output.find("plugin path") == std::string::npos);  // not blamed on the plugin folders
-  r = run_frostmpm("describe grid");
+  r = run_frostmpm("describe boundary_conditions/temperature");
   INFO(r.output);
   CHECK(r.exit_code == 2);
-  CHECK(r.output.find("'grid' is a scene section the kernel reads") != std::string::npos);
+  CHECK(r.output.find("'boundary_conditions' is a scene section whose keys depend on the physics") != std::string::npos);
   CHECK(r.output.find("docs/config-reference.md") != std::string::npos);
+  CHECK(r.output.find("Described here: grid, time, output, checkpoint") != std::string::npos);
+}
+
+TEST_CASE("describe grid, time, output and checkpoint: the kernel's sections with units, defaults and ranges",
+          "[cli]") {
+  auto r = run_frostmpm("describe grid");
+  INFO(r.output);
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("grid — a scene section the kernel reads") != std::string::npos);
+  CHECK(r.output.find("cell_size") != std::string::npos);
+  CHECK(r.output.find("particles_per_cell") != std::string::npos);
+  r = run_frostmpm("describe time");
+  INFO(r.output);
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("mass_scaling") != std::string::npos);
+  for (const char* section : {"output", "checkpoint"}) CHECK(run_frostmpm(std::string("describe ") + section).exit_code == 0);
 }
 
 TEST_CASE("check reports how many of each condition's nodes carry material", "[cli]") {
