@@ -321,11 +321,12 @@ std::vector<double> Probes::sample_line(const Probe& probe) const {
   const double length = std::hypot(probe.to[0] - probe.from[0], probe.to[1] - probe.from[1]);
   const int samples = std::max(2, static_cast<int>(std::ceil(4 * length / sources_.grid->min_spacing())));
   std::vector<double> values(static_cast<std::size_t>(samples) + 1);
+  const auto nodal = nodal_average(probe.field);  // once: the line samples it many times
   for (int s = 0; s <= samples; ++s) {
     const double f = double(s) / samples;
     values[static_cast<std::size_t>(s)] =
-        sample_field(probe.field, {probe.from[0] + f * (probe.to[0] - probe.from[0]),
-                                   probe.from[1] + f * (probe.to[1] - probe.from[1])}) -
+        interpolate(nodal, {probe.from[0] + f * (probe.to[0] - probe.from[0]),
+                            probe.from[1] + f * (probe.to[1] - probe.from[1])}) -
         probe.value;
   }
   return values;
@@ -358,12 +359,32 @@ std::vector<std::pair<std::string, std::string>> Probes::column_units() const {
 }
 
 double Probes::sample_field(const std::string& field, const std::array<double, kDim>& point) const {
-  // Volume-weighted nodal average of the particle field, then bilinear interpolation.
-  const auto& grid = *sources_.grid;
+  return interpolate(nodal_average(field), point);
+}
+
+std::pair<std::vector<double>, std::vector<double>> Probes::nodal_average(const std::string& field) const {
   const auto& stencil = sources_.transfer->stencil();
   const auto [values, component, stride] = scalar_column(field);
   const auto vol = sources_.particles->field("volume");
   const std::size_t K = static_cast<std::size_t>(stencil.per_particle());
+  std::vector<double> sum(sources_.grid->node_count(), 0.0), weight(sum.size(), 0.0);
+  // Serial: a probe row is far cheaper than a step, and the sums stay independent of threads.
+  for (std::size_t p = 0; p < sources_.particles->size(); ++p) {
+    const auto* nodes = stencil.nodes(p);
+    const auto* w = stencil.weights(p);
+    for (std::size_t k = 0; k < K; ++k) {
+      sum[nodes[k]] += vol[p] * w[k] * values[p * stride + component];
+      weight[nodes[k]] += vol[p] * w[k];
+    }
+  }
+  for (std::size_t i = 0; i < sum.size(); ++i)
+    if (weight[i] > 0) sum[i] /= weight[i];
+  return {std::move(sum), std::move(weight)};
+}
+
+double Probes::interpolate(const std::pair<std::vector<double>, std::vector<double>>& nodal,
+                           const std::array<double, kDim>& point) const {
+  const auto& grid = *sources_.grid;
   std::array<int, kDim> base{};
   std::array<double, kDim> frac{};
   for (int d = 0; d < kDim; ++d) {
@@ -371,31 +392,15 @@ double Probes::sample_field(const std::string& field, const std::array<double, k
     base[d] = std::min(static_cast<int>(std::floor(xi)), grid.cells[d] - 1);
     frac[d] = xi - base[d];
   }
-  std::array<std::size_t, 4> corner{};
-  std::array<double, 4> cw{}, num{}, den{};
+  double value = 0, weight = 0;
   for (int c = 0; c < 4; ++c) {
     const int a = c & 1, b = c >> 1;
-    corner[c] = grid.node_index({base[0] + a, base[1] + b});
-    cw[c] = (a ? frac[0] : 1 - frac[0]) * (b ? frac[1] : 1 - frac[1]);
+    const std::size_t node = grid.node_index({base[0] + a, base[1] + b});
+    if (!(nodal.second[node] > 0)) continue;  // no particle reaches this corner
+    const double cw = (a ? frac[0] : 1 - frac[0]) * (b ? frac[1] : 1 - frac[1]);
+    value += cw * nodal.first[node];
+    weight += cw;
   }
-  // Only particles whose stencil touches the four corners contribute.
-  const std::size_t n = sources_.particles->size();
-  for (std::size_t p = 0; p < n; ++p) {
-    const auto* nodes = stencil.nodes(p);
-    const auto* w = stencil.weights(p);
-    for (std::size_t k = 0; k < K; ++k)
-      for (int c = 0; c < 4; ++c)
-        if (nodes[k] == corner[c]) {
-          num[c] += vol[p] * w[k] * values[p * stride + component];
-          den[c] += vol[p] * w[k];
-        }
-  }
-  double value = 0, weight = 0;
-  for (int c = 0; c < 4; ++c)
-    if (den[c] > 0) {
-      value += cw[c] * num[c] / den[c];
-      weight += cw[c];
-    }
   return weight > 0 ? value / weight : std::numeric_limits<double>::quiet_NaN();
 }
 

@@ -104,6 +104,12 @@ class Probes {
 
   /// The probe's field minus its level at evenly spaced points from `from` to `to` (4 per cell).
   std::vector<double> sample_line(const Probe& probe) const;
+  /// The volume-weighted nodal average Σ V_p S_ip f_p / Σ V_p S_ip of a scalar name, one pass
+  /// over the particles; 0 weight where no particle reaches. {average, weight} per node.
+  std::pair<std::vector<double>, std::vector<double>> nodal_average(const std::string& field) const;
+  /// Bilinear interpolation of a nodal average to a point, over the corners some particle reaches.
+  double interpolate(const std::pair<std::vector<double>, std::vector<double>>& nodal,
+                     const std::array<double, kDim>& point) const;
 
   Sources sources_;
   std::vector<std::unique_ptr<Probe>> probes_;
