@@ -312,22 +312,13 @@ void HydraulicPhysics::update_cell_stabilization() {
   const auto G = shear_modulus_.bound() ? shear_modulus_.values() : std::span<const double>{};
   const double tau = params_.real("stabilization");
   for (std::size_t q = 0; q < vol.size(); ++q) {
-    const double weight = vol[q] * (G.empty() ? materials_[material_[q]].stabilization : G[q] > 0 ? tau / (2.0 * G[q]) : 0.0);
-    if (weight == 0) continue;
-    std::size_t c = 0, stride = 1;
-    for (int d = 0; d < kDim; ++d) {
-      const int i = std::clamp(static_cast<int>(std::floor((x[q * kDim + d] - grid.origin[d]) / grid.spacing[d])), 0,
-                               grid.cells[d] - 1);
-      c += static_cast<std::size_t>(i) * stride;
-      stride *= static_cast<std::size_t>(grid.cells[d]);
-    }
-    cell_stabilization_[c] += weight;
-    fill[c] += vol[q];
+    const std::size_t c = grid.cell_of(x.data() + q * kDim);
+    fill[c] += vol[q];  // every particle fills its cell, whether or not it adds to H
+    cell_stabilization_[c] +=
+        vol[q] * (G.empty() ? materials_[material_[q]].stabilization : G[q] > 0 ? tau / (2.0 * G[q]) : 0.0);
   }
-  double cell_volume = 1;
-  for (int d = 0; d < kDim; ++d) cell_volume *= grid.spacing[d];
   for (std::size_t c = 0; c < fill.size(); ++c)
-    if (fill[c] < kProjectionMinimumFill * cell_volume) cell_stabilization_[c] = 0;
+    if (fill[c] < kProjectionMinimumFill * grid.cell_volume()) cell_stabilization_[c] = 0;
   stabilization_version_ = kernel_->transfer().version();
 }
 
