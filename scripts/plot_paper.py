@@ -10,6 +10,7 @@
     /usr/bin/python3 scripts/plot_paper.py stabilization OUT_tau0 OUT_tau0.1 OUT_tau0.5 OUT_tau1 [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py footing_thermal OUT_0.2 OUT_0.1 [OUT_0.05] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py footing OUT_unthawed OUT_thawing OUT_prethawed [...] [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py slump OUT [--png FILE] [--frame N]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
@@ -31,7 +32,10 @@ frame's temperature with the −1, 0 and 1 °C lines per mesh (Fig. 24A–C), th
 and the thaw depths against time, one line per mesh (Fig. 24E–F). footing: the THM runs of the
 strip footing (configs/paper/strip_footing.yaml): footing pressure against d/B with the
 Prandtl–Reissner pressure of the thawed soil (Fig. 27), and each run's plastic deviatoric strain
-at its last frame with the −1 and 0 °C lines (Figs. 25–26). Each OUT is a run folder (metrics.csv, fields.h5).
+at its last frame with the −1 and 0 °C lines (Figs. 25–26). slump: the thaw slump of Sec. 5.3.1
+(configs/paper/thaw_slump.yaml) at one frame (the last unless --frame): temperature, plastic
+deviatoric strain and displacement, each with the thaw front (S_l = ½) and the slope's initial
+surface (Figs. 20–22), and the thaw depths and displacements against time. Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -386,11 +390,68 @@ def footing(folders, png):
     frostplot.save(fig, png)
 
 
+# ---- thaw slump (Sec. 5.3.1) ------------------------------------------------------------------
+
+SLUMP_SURFACE = [(0, 0.455), (0.35, 0.455), (1.1361128709, 0.105), (1.4, 0.105)]  # thaw_slump.yaml
+
+
+def slump_neumann_estimate():
+    """1-D Neumann thaw of the slump's soil (φ 0.4, arithmetic mixing, S_l = 0.042 at −10 °C from
+    its SFCC), +10 °C on −10 °C, a sharp front at 0 °C; X(t) with t in days (the run's seconds)."""
+    phi, s_l = 0.4, 0.042
+    k_t, c_t = 0.6 * 1.0 + phi * 0.6, 0.6 * 2650 * 837 + phi * 1000 * 4200
+    k_f = 0.6 * 1.0 + phi * (s_l * 0.6 + (1 - s_l) * 2.2)
+    c_f = 0.6 * 2650 * 837 + phi * (s_l * 1000 * 4200 + (1 - s_l) * 917 * 2060)
+    front = neumann_front(k_t, c_t, k_f, c_f, phi * (1 - s_l) * 917 * 3.34e5, 10.0, -10.0)
+    return lambda days: front(86400.0 * np.asarray(days))
+
+
+def slump(folder, png, frame):
+    """Temperature, plastic deviatoric strain and displacement of one frame (Figs. 20–22) with the
+    thaw front and the initial surface, and the probes against time."""
+    fr = frostplot.read_fields.read_frames(folder)[frame]
+    x, y = fr["coordinates"][:, 0], fr["coordinates"][:, 1]
+    f = fr["fields"]
+    u = np.asarray(f["displacement"])
+    panels = [("temperature", f["temperature"], np.linspace(-10, 10, 21), "coolwarm", "T [°C]"),
+              ("plastic deviatoric strain", f["plastic_deviatoric_strain"], np.linspace(0, 0.25, 11), "viridis",
+               "plastic deviatoric strain"),
+              ("displacement", np.hypot(u[:, 0], u[:, 1]), None, "viridis", "|u| [m]")]
+    fig, axes = plt.subplots(2, 2, figsize=(13, 7.5))
+    surface = np.array(SLUMP_SURFACE)
+    for ax, (title, values, levels, cmap, label) in zip(axes.flat, panels):
+        frostplot.scalar_panel(ax, fig, fr, np.asarray(values), label, levels=levels, cmap=cmap)
+        tri = frostplot.triangulation(fr["coordinates"][:, :2])
+        ax.tricontour(tri, f["liquid_saturation"], levels=[0.5], colors="w" if cmap == "viridis" else "k",
+                      linewidths=1.2, linestyles="--")
+        ax.plot(surface[:, 0], surface[:, 1], color="0.4", lw=0.8, ls=":")
+        ax.set(xlim=(0, 1.4), ylim=(0, 0.5), title=f"{title}, t = {fr['time']:.1f} s ({fr['time']:.1f} days of thaw)")
+    if "displacement" in f:
+        step = max(1, len(x) // 400)
+        axes.flat[2].quiver(x[::step], y[::step], u[::step, 0], u[::step, 1], angles="xy", scale_units="xy", scale=1,
+                            width=0.002, color="w")
+    m = metrics(folder)
+    a = axes.flat[3]
+    a.plot(m["time_s"], m["thaw_depth_crest"], label="thaw depth, crest (vertical)")
+    a.plot(m["time_s"], m["thaw_depth_face"], label="thaw depth, face middle (normal)")
+    a.plot(m["time_s"], slump_neumann_estimate()(m["time_s"]), "k:", label="Neumann, 1-D")
+    a.set(xlabel="t [s] = days of thaw", ylabel="depth [m]", title="thaw and movement (dashed: S_l = ½)")
+    b = a.twinx()
+    b.plot(m["time_s"], m["face_mid_x"], "C2--", label="face middle, u_x")
+    b.plot(m["time_s"], m["toe_x"], "C3--", label="toe, u_x")
+    b.plot(m["time_s"], -m["crest_edge_y"], "C4--", label="crest edge, settlement")
+    b.set(ylabel="displacement [m]")
+    lines = a.get_legend_handles_labels()
+    more = b.get_legend_handles_labels()
+    a.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="upper left")
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
-                                                      "footing_thermal", "footing"])
+                                                      "footing_thermal", "footing", "slump"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -412,6 +473,8 @@ def main():
         footing_thermal(args.folders, png)
     elif args.figure == "footing":
         footing(args.folders, png)
+    elif args.figure == "slump":
+        slump(args.folders[0], png, args.frame)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

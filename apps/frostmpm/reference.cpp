@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/scene/plugin_setup.hpp"
 #include "frostmpm/simulation/simulation.hpp"
 
@@ -22,6 +23,9 @@ struct LoadedRegistry {
 // Models are chosen with `model:` inside a section; physics are keys of `physics:`.
 std::string scene_form(const RegistryEntry& e) {
   if (e.kind == "physics") return "physics: {" + e.name + ": {...}}";
+  if (e.kind == BoundaryType::kKind)
+    return "boundary_conditions: [{type: " + e.name + ", nodes: ... or particles: ..." +
+           (e.schema.params().empty() ? "" : ", ...") + "}]";
   return "{model: " + e.name + (e.schema.params().empty() ? "}" : ", ...}");
 }
 
@@ -49,12 +53,17 @@ void describe_text(const RegistryEntry& e, std::ostream& out) {
   out << e.kind << "/" << e.name << " — " << e.doc << "\n";
   out << "  from " << e.plugin << " " << e.version << " (" << e.library << ")\n";
   out << "  YAML: " << scene_form(e) << "\n";
+  if (e.schema.params().empty()) out << "  (no keys of its own)\n";
   parameter_table(e.schema, out);
 }
 
 void describe_markdown(const RegistryEntry& e, std::ostream& out) {
   out << "### `" << e.kind << "/" << e.name << "`\n\n" << e.doc << ".\n\n";
   out << "Plugin `" << e.plugin << "`. Scene form: `" << scene_form(e) << "`.\n\n";
+  if (e.schema.params().empty()) {
+    out << "No keys of its own.\n\n";
+    return;
+  }
   out << "| parameter | type | unit | default | allowed | description |\n|---|---|---|---|---|---|\n";
   for (const auto& p : e.schema.params()) {
     const std::string range = p.type == ParamType::Choice ? join(p.choices) : p.range_text();

@@ -99,9 +99,7 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   sim.fill_from_materials("porosity", "porosity");
   material_ = sim.transfer().materials();
   read_boundaries(sim);
-  for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());
-  std::sort(pressure_nodes_.begin(), pressure_nodes_.end());
-  pressure_nodes_.erase(std::unique(pressure_nodes_.begin(), pressure_nodes_.end()), pressure_nodes_.end());
+  update_pressure_nodes({});
   // A hydrostatic boundary acts on nodes, not on a material: it needs one water density.
   hydrostatic_density_ = materials_.front().water_density;
   for (const auto& bc : pressure_bcs_)
@@ -119,15 +117,38 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   for (auto* v : {&node_mass_, &rhs_}) v->assign(nodes, 0.0);
 }
 
+namespace {
+// Boundary values beyond these are typos or overflow, refused at setup (Pa and m/s).
+constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
+constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
+}  // namespace
+
+std::vector<BoundaryType> HydraulicPhysics::boundary_type_docs() {
+  std::vector<BoundaryType> types(2);
+  types[0].name = "pore_pressure";
+  types[0].doc = "a prescribed pore pressure (Eq. 19) on faces, node boxes or particles; on particles it holds the nodes "
+                 "they make up at least half of, following the material as it moves (a drained surface inside the grid)";
+  types[0].keys.real("value", "-", std::string("the pressure [Pa], or with hydrostatic: true the water table's elevation "
+                                               "[m], a time function") + kTimeFunction)
+      .at_least(-kMaxPressure).at_most(kMaxPressure);
+  types[0].keys.boolean("hydrostatic", "p = ρ_l g (h − y) below the water table h given as value (a suction above it)")
+      .defaults_to(false);
+  types[1].name = "water_flux";
+  types[1].doc = "Darcy flux flowing into the domain (Eq. 22) through a face";
+  types[1].keys.real("value", "m/s", std::string("the flux into the domain, a time function") + kTimeFunction)
+      .at_least(-kMaxWaterFlux).at_most(kMaxWaterFlux);
+  return types;
+}
+
 void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
-  // Boundary values beyond these are typos or overflow, refused at setup (Pa and m/s).
-  constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
+  const auto types = boundary_type_docs();
+  const auto keys = [&](const char* type) { return boundary_type(types, type).keys.names(); };
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("pore_pressure")) {
-    bc->accept_keys({"value", "hydrostatic"});
-    if (bc->on_particles) throw bc->node->error("pore_pressure acts on grid nodes: use nodes: {face: ...} or {box: ...}");
+    bc->accept_keys(keys("pore_pressure"));
     PressureCondition c;
     c.nodes = bc->nodes;
+    c.particles = bc->particles;
     if (auto h = bc->node->optional_child("hydrostatic")) c.hydrostatic = h->as_bool();
     // Hydrostatic: the value is the water table's elevation.
     c.value = TimeFunction::read(bc->node->child("value"), c.hydrostatic ? "m" : "Pa", kMaxPressure, end);
@@ -135,7 +156,7 @@ void HydraulicPhysics::read_boundaries(Kernel<kDim>& sim) {
     pressure_bcs_.push_back(std::move(c));
   }
   for (auto* bc : sim.boundary_conditions("water_flux")) {
-    bc->accept_keys({"value"});
+    bc->accept_keys(keys("water_flux"));
     const bool face = !bc->on_particles &&
                       std::any_of(bc->node_areas.begin(), bc->node_areas.end(), [](double a) { return a > 0; });
     if (!face) throw bc->node->error("water_flux acts on a grid face: use nodes: {face: ...}");
@@ -158,6 +179,34 @@ std::vector<double> HydraulicPhysics::boundary_pressures(const PressureCondition
     throw NumericalBlowUp(msg.str());
   }
   return p;
+}
+
+/// A pore_pressure condition on particles holds the nodes those particles make up at least half
+/// of (by volume), as a temperature condition on particles does: the surface's own nodes,
+/// wherever the material has moved it (a drained slope face or ground surface inside the grid).
+void HydraulicPhysics::update_pressure_nodes(const std::vector<double>& node_volume) {
+  if (!node_volume.empty()) {
+    const auto& st = kernel_->transfer().stencil();
+    const auto vol = volume_.values();
+    const int K = st.per_particle();
+    std::vector<double> share(node_volume.size());
+    for (auto& bc : pressure_bcs_) {
+      if (bc.particles.empty()) continue;
+      std::fill(share.begin(), share.end(), 0.0);
+      for (std::size_t p : bc.particles) {
+        const auto* nodes = st.nodes(p);
+        const auto* w = st.weights(p);
+        for (int k = 0; k < K; ++k) share[nodes[k]] += vol[p] * w[k];
+      }
+      bc.nodes.clear();
+      for (std::size_t i = 0; i < share.size(); ++i)
+        if (share[i] > 0 && share[i] >= 0.5 * node_volume[i]) bc.nodes.push_back(i);
+    }
+  }
+  pressure_nodes_.clear();
+  for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());
+  std::sort(pressure_nodes_.begin(), pressure_nodes_.end());
+  pressure_nodes_.erase(std::unique(pressure_nodes_.begin(), pressure_nodes_.end()), pressure_nodes_.end());
 }
 
 void HydraulicPhysics::set_boundary_pressures(double t) {
@@ -376,6 +425,9 @@ void HydraulicPhysics::map_to_grid() {
   const auto phi = porosity_.values();
   std::fill(node_mass_.begin(), node_mass_.end(), 0.0);
   std::vector<double> pore_mass(node_mass_.size(), 0.0);
+  const bool on_particles =
+      std::any_of(pressure_bcs_.begin(), pressure_bcs_.end(), [](const auto& bc) { return !bc.particles.empty(); });
+  std::vector<double> node_volume(on_particles ? node_mass_.size() : 0, 0.0);
   const int K = st.per_particle();
   kernel_->transfer().scatter([&](std::size_t q) {
     const auto* nodes = st.nodes(q);
@@ -384,8 +436,10 @@ void HydraulicPhysics::map_to_grid() {
     for (int k = 0; k < K; ++k) {
       node_mass_[nodes[k]] += w[k] * pores * (n_l_[q] / phi[q]);
       pore_mass[nodes[k]] += w[k] * pores;
+      if (on_particles) node_volume[nodes[k]] += w[k] * vol[q];
     }
   });
+  if (on_particles) update_pressure_nodes(node_volume);
   parallel_for(node_mass_.size(), [&](std::size_t i) {
     if (node_mass_[i] <= kWetFraction * pore_mass[i]) node_mass_[i] = 0.0;
   });
@@ -547,6 +601,7 @@ void HydraulicPhysics::removing_particles(const ParticleRemoval& removal) {
 }
 
 FROSTMPM_REGISTER(Physics, HydraulicPhysics)
+FROSTMPM_REGISTER_BOUNDARY_TYPES(HydraulicPhysics)
 
 }  // namespace frostmpm::hydraulic
 

@@ -27,6 +27,7 @@
 
 #include "frostmpm/linalg/sparse_system.hpp"
 #include "frostmpm/models/permeability_model.hpp"
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
 #include "frostmpm/physics/kernel.hpp"
@@ -50,7 +51,8 @@ class HydraulicPhysics final : public Physics {
     return {{"absolute_permeability", AbsolutePermeabilityModel::kKind, true},
             {"relative_permeability", RelativePermeabilityModel::kKind, false}};
   }
-  std::vector<std::string> boundary_types() const override { return {"pore_pressure", "water_flux"}; }
+  static std::vector<BoundaryType> boundary_type_docs();
+  std::vector<std::string> boundary_types() const override { return boundary_type_names(boundary_type_docs()); }
 
   void setup(Kernel<kDim>& kernel) override;
   std::vector<Stage> stages() override;
@@ -67,7 +69,8 @@ class HydraulicPhysics final : public Physics {
 
  private:
   struct PressureCondition {
-    std::vector<std::size_t> nodes;
+    std::vector<std::size_t> nodes;      ///< on particles: the nodes they make up at least half of
+    std::vector<std::size_t> particles;  ///< a condition on particles (a surface inside the grid)
     TimeFunction value;     ///< pressure [Pa], or the water-table elevation [m] when hydrostatic
     bool hydrostatic = false;
     std::string label;
@@ -186,6 +189,9 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> boundary_pressures(const PressureCondition& c, double t) const;
   /// Nodal pressure = the boundary values at t on every pressure boundary.
   void set_boundary_pressures(double t);
+  /// The nodes of pressure conditions on particles, from where the particles are now, and
+  /// pressure_nodes_ (every condition's nodes, sorted) with them.
+  void update_pressure_nodes(const std::vector<double>& node_volume);
   void update_coefficients();
   /// The volume source of every particle over the step that just ended; primes on the first call.
   void update_source();

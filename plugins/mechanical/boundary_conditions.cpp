@@ -55,12 +55,6 @@ std::vector<std::string> axis_keys() {
   return keys;
 }
 
-template <typename T>
-std::vector<T> with(std::vector<T> items, const std::vector<T>& more) {
-  items.insert(items.end(), more.begin(), more.end());
-  return items;
-}
-
 template <int Dim>
 int read_axis(const ConfigNode& node) {
   const std::string c = node.as_string();
@@ -69,6 +63,73 @@ int read_axis(const ConfigNode& node) {
   throw node.error("unknown component '" + c + "'; valid: x, y" + std::string(Dim == 3 ? ", z" : ""));
 }
 
+constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
+
+/// The components x, y, z of a condition's value, each a time function in `unit`.
+void component_keys(ParamSchema& keys, const std::string& unit, const std::string& what, double bound) {
+  for (int d = 0; d < 3; ++d)
+    keys.real(axis_name(d), unit, what + " along " + axis_name(d) + (d == 2 ? " (3-D only)" : "") + ", a time function" +
+                                      kTimeFunction)
+        .optional("not prescribed")
+        .at_least(-bound)
+        .at_most(bound);
+}
+
+}  // namespace
+
+std::vector<BoundaryType> mechanical_boundary_types() {
+  std::vector<BoundaryType> t(8);
+  t[0].name = "fixed";
+  t[0].doc = "every velocity component of the nodes 0 (faces, node boxes)";
+  t[1].name = "roller";
+  t[1].doc = "one velocity component of the nodes 0: a face's normal, or `component` (faces, node boxes)";
+  t[1].keys.choice("component", {"x", "y", "z"}, "the component held at 0 (required on a node box)")
+      .optional("the face's normal");
+  t[2].name = "velocity";
+  t[2].doc = "the components given follow their time functions (faces, node boxes; at least one component)";
+  component_keys(t[2].keys, "m/s", "the velocity", kMaxVelocity);
+  t[3].name = "traction";
+  t[3].doc = "force per area on the material, tension positive (faces): normal and shear, or components";
+  t[3].keys.real("normal", "Pa", std::string("along the face's outward normal, a time function") + kTimeFunction)
+      .optional("none").at_least(-kMaxTraction).at_most(kMaxTraction);
+  t[3].keys.real("shear", "Pa", std::string("along the face (2-D), a time function") + kTimeFunction)
+      .optional("none").at_least(-kMaxTraction).at_most(kMaxTraction);
+  component_keys(t[3].keys, "Pa", "the traction", kMaxTraction);
+  t[4].name = "surcharge";
+  t[4].doc = "a pressure pushing into the material (faces, or particles, whose outward normal is then given; on "
+             "particles it follows the material as it moves)";
+  t[4].keys.real("value", "Pa", std::string("the pressure, a time function") + kTimeFunction)
+      .at_least(-kMaxTraction).at_most(kMaxTraction);
+  t[4].keys.reals("normal", "-", "on particles: their outward normal along an axis, e.g. [0, 1]")
+      .optional("a face's own");
+  t[5].name = "rigid_plate";
+  t[5].doc = "a rigid frictionless plate on a face carrying the total force into the material; its nodes move as one "
+             "along the face's normal";
+  t[5].keys.real("force", "N/m", std::string("the total force (per m in 2-D), a time function") + kTimeFunction)
+      .at_least(-1e12).at_most(1e12);
+  t[6].name = "footing";
+  t[6].doc = "a rigid footing driven at a prescribed velocity along one axis (a node box, which moves with it): the "
+             "nodes inside it follow it; footing_* probes report its force and pressure";
+  component_keys(t[6].keys, "m/s", "the footing's velocity (exactly one component; ramp it from 0)", kMaxVelocity);
+  t[6].keys.choice("contact", {"rough", "smooth"}, "rough: the other components held at 0; smooth: frictionless")
+      .defaults_to("rough");
+  t[7].name = "friction";
+  t[7].doc = "a rigid wall on a face the material may leave but not cross, sliding along it against Coulomb "
+             "friction μ = tan δ";
+  t[7].keys.real("friction_angle", "degree", "the wall's friction angle δ (0: smooth)").at_least(0).below(90);
+  return t;
+}
+
+namespace {
+/// The keys a condition of `type` accepts in Dim dimensions (no z in 2-D).
+template <int Dim>
+std::vector<std::string> accepted_keys(const std::string& type) {
+  static const auto types = mechanical_boundary_types();
+  std::vector<std::string> keys;
+  for (const auto& k : boundary_type(types, type).keys.names())
+    if (Dim == 3 || k != "z") keys.push_back(k);
+  return keys;
+}
 }  // namespace
 
 template <int Dim>
@@ -109,14 +170,14 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     velocity_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("fixed")) {
-    bc->accept_keys({});
+    bc->accept_keys(accepted_keys<Dim>("fixed"));
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     for (int d = 0; d < Dim; ++d) value[d] = TimeFunction::constant(0.0);
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("roller")) {
-    bc->accept_keys({"component"});
+    bc->accept_keys(accepted_keys<Dim>("roller"));
     on_nodes(bc);
     int axis = bc->face_axis;
     if (auto component = bc->node->optional_child("component")) axis = read_axis<Dim>(*component);
@@ -126,7 +187,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("velocity")) {
-    bc->accept_keys(axis_keys<Dim>());
+    bc->accept_keys(accepted_keys<Dim>("velocity"));
     on_nodes(bc);
     std::array<std::optional<TimeFunction>, Dim> value;
     bool any = false;
@@ -141,7 +202,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_velocity(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("rigid_plate")) {
-    bc->accept_keys({"force"});
+    bc->accept_keys(accepted_keys<Dim>("rigid_plate"));
     on_nodes(bc);
     if (bc->face_axis < 0) throw bc->node->error("rigid_plate acts on a grid face: use nodes: {face: ...}");
     PlateCondition c;
@@ -164,7 +225,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     plates_.push_back(std::move(c));
   }
   for (auto* bc : kernel.boundary_conditions("friction")) {
-    bc->accept_keys({"friction_angle"});
+    bc->accept_keys(accepted_keys<Dim>("friction"));
     on_nodes(bc);
     if (bc->face_axis < 0) throw bc->node->error("a friction wall lies on a grid face: use nodes: {face: ...}");
     const ConfigNode angle = bc->node->child("friction_angle");
@@ -216,7 +277,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     traction_bcs_.push_back(std::move(c));
   };
   for (auto* bc : kernel.boundary_conditions("traction")) {
-    bc->accept_keys(with<std::string>({"normal", "shear"}, axis_keys<Dim>()));
+    bc->accept_keys(accepted_keys<Dim>("traction"));
     std::array<TimeFunction, Dim> value;
     bool by_components = false;
     for (int d = 0; d < Dim; ++d) by_components = by_components || bc->node->has(axis_name(d));
@@ -242,7 +303,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
     add_traction(bc, std::move(value));
   }
   for (auto* bc : kernel.boundary_conditions("surcharge")) {
-    bc->accept_keys({"value", "normal"});
+    bc->accept_keys(accepted_keys<Dim>("surcharge"));
     int axis = bc->face_axis, side = bc->face_side;
     if (bc->on_particles) {
       axis = particle_normal_axis(*bc);
@@ -260,7 +321,7 @@ void MechanicalPhysics<Dim>::read_boundaries(Kernel<Dim>& kernel) {
 
 template <int Dim>
 void MechanicalPhysics<Dim>::read_footing(BoundaryCondition& bc, const Kernel<Dim>& kernel) {
-  bc.accept_keys(with<std::string>({"contact"}, axis_keys<Dim>()));
+  bc.accept_keys(accepted_keys<Dim>("footing"));
   if (bc.on_particles || bc.face_axis >= 0)
     throw bc.node->error("a footing is a rigid body: give its extent as nodes: {box: {min: [...], max: [...]}}; the "
                          "grid nodes inside the box, as it moves, follow the footing");

@@ -28,10 +28,15 @@
 #include <vector>
 
 #include "frostmpm/models/mechanical_model.hpp"
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
 
 namespace frostmpm::mechanical {
+
+/// The skeleton's boundary-condition types and their keys (boundary_conditions.cpp): what
+/// `describe boundary_conditions/TYPE` prints and what each condition accepts.
+std::vector<BoundaryType> mechanical_boundary_types();
 
 template <int Dim>
 class MechanicalPhysics final : public Physics {
@@ -43,9 +48,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<ModelSlot> material_models() const override {
     return {{"mechanical_model", MechanicalModel::kKind, true}};
   }
-  std::vector<std::string> boundary_types() const override {
-    return {"fixed", "roller", "velocity", "traction", "surcharge", "rigid_plate", "footing", "friction"};
-  }
+  std::vector<std::string> boundary_types() const override { return boundary_type_names(mechanical_boundary_types()); }
 
   void setup(Kernel<Dim>& kernel) override;
   std::vector<Stage> stages() override;

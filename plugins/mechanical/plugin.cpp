@@ -13,10 +13,12 @@ class Mechanical final : public DimensionalPhysics<MechanicalPhysics> {
       "the solid skeleton: momentum with gravity and tractions, effective stress with a constitutive model per "
       "material, Jaumann rate, moving material points (with hydraulic: the two-phase fractional step)";
   static ParamSchema schema() { return MechanicalPhysics<2>::schema(); }
+  static std::vector<BoundaryType> boundary_type_docs() { return mechanical_boundary_types(); }
   using DimensionalPhysics::DimensionalPhysics;
 };
 
 FROSTMPM_REGISTER(Physics, Mechanical)
+FROSTMPM_REGISTER_BOUNDARY_TYPES(Mechanical)
 
 }  // namespace frostmpm::mechanical
 

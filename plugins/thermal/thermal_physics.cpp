@@ -122,12 +122,41 @@ std::vector<Stage> ThermalPhysics::stages() {
            [this] { map_to_particles(); }}};
 }
 
+namespace {
+// Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
+constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
+constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
+}  // namespace
+
+std::vector<BoundaryType> ThermalPhysics::boundary_type_docs() {
+  std::vector<BoundaryType> types(3);
+  types[0].name = "temperature";
+  types[0].doc = "a prescribed temperature (Eq. 20) on faces, node boxes or particles; on particles it holds them and the "
+                 "nodes they make up at least half of, following the material as it moves";
+  types[0].keys.real("value", "degC", std::string("the temperature, a time function") + kTimeFunction)
+      .at_least(-kMaxTemperature).at_most(kMaxTemperature);
+  types[1].name = "heat_flux";
+  types[1].doc = "heat flowing into the domain (Eq. 23) through a face, or through the surface particles stand for";
+  types[1].keys.real("value", "W/m^2", std::string("the flux into the domain, a time function") + kTimeFunction)
+      .at_least(-kMaxHeatFlux).at_most(kMaxHeatFlux);
+  types[1].keys.real("area", "m^2", "on particles only: the surface they stand for (per m in 2-D), shared by volume")
+      .optional("a face's own area").above(0).at_most(1e6);
+  types[2].name = "convective";
+  types[2].doc = "h (T_a − T) into the domain (Eq. 24) through a face, or through the surface particles stand for";
+  types[2].keys.real("h", "W/(m^2 K)", "heat transfer coefficient").above(0);
+  types[2].keys.real("ambient", "degC", std::string("the ambient temperature T_a, a time function") + kTimeFunction)
+      .at_least(-kMaxTemperature).at_most(kMaxTemperature);
+  types[2].keys.real("area", "m^2", "on particles only: the surface they stand for (per m in 2-D), shared by volume")
+      .optional("a face's own area").above(0).at_most(1e6);
+  return types;
+}
+
 void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
-  // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
-  constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
+  const auto types = boundary_type_docs();
+  const auto keys = [&](const char* type) { return boundary_type(types, type).keys.names(); };
   const double end = sim.end_time();
   for (auto* bc : sim.boundary_conditions("temperature")) {
-    bc->accept_keys({"value"});
+    bc->accept_keys(keys("temperature"));
     TimeFunction value = TimeFunction::read(bc->node->child("value"), "degC", kMaxTemperature, end);
     if (bc->on_particles) particle_T_.push_back({bc->particles, value, bc->label()});
     else fixed_T_.push_back({bc->nodes, bc->node_areas, value, 0, bc->label()});
@@ -149,13 +178,13 @@ void ThermalPhysics::read_boundaries(Kernel<kDim>& sim) {
       throw bc->node->error(bc->type + " acts on a grid face or on particles: use nodes: {face: ...} or particles: SHAPE with area:");
   };
   for (auto* bc : sim.boundary_conditions("heat_flux")) {
-    bc->accept_keys({"value", "area"});
+    bc->accept_keys(keys("heat_flux"));
     surface(bc, flux_);
     flux_.push_back(
         {bc->nodes, bc->node_areas, TimeFunction::read(bc->node->child("value"), "W/m^2", kMaxHeatFlux, end), 0.0, bc->label()});
   }
   for (auto* bc : sim.boundary_conditions("convective")) {
-    bc->accept_keys({"h", "ambient", "area"});
+    bc->accept_keys(keys("convective"));
     surface(bc, convective_);
     const ConfigNode h = bc->node->child("h");
     const double coefficient = h.as_real("W/(m^2 K)");
@@ -407,9 +436,8 @@ void ThermalPhysics::update_node_pore_heat() {
 /// Dirichlet nodes take their value at `time`; the heat that takes enters through the boundary.
 void ThermalPhysics::apply_dirichlet_nodes(double time) {
   double added = 0;
-  for (const auto& bc : fixed_T_) {
-    const double value = value_at(bc, time);
-    for (std::size_t i : bc.nodes) {
+  auto hold = [&](const std::vector<std::size_t>& nodes, double value) {
+    for (std::size_t i : nodes) {
       if (node_volume_[i] <= 0) continue;
       dirichlet_[i] = 1;
       const double e = nodal_.heat(i, value);
@@ -417,12 +445,18 @@ void ThermalPhysics::apply_dirichlet_nodes(double time) {
       node_heat_[i] = e;
       (*node_T_)[i] = value;
     }
-  }
+  };
+  for (const auto& bc : fixed_T_) hold(bc.nodes, value_at(bc, time));
+  for (const auto& bc : particle_T_) hold(bc.nodes, value_at(bc, time));
   boundary_heat_ += added;
 }
 
 void ThermalPhysics::set_dirichlet_targets(double time) {
   for (const auto& bc : fixed_T_) {
+    const double value = value_at(bc, time);
+    for (std::size_t i : bc.nodes) dirichlet_target_[i] = value;
+  }
+  for (const auto& bc : particle_T_) {
     const double value = value_at(bc, time);
     for (std::size_t i : bc.nodes) dirichlet_target_[i] = value;
   }
@@ -441,6 +475,7 @@ void ThermalPhysics::map_to_grid() {
   // Particles moved (or nothing is carried yet, or particle temperature conditions reset some
   // particles): the grid state is re-derived from the particles.
   if (!grid_valid_ || st.version() != grid_stencil_version_ || !particle_T_.empty()) project_to_grid(true);
+  if (!particle_T_.empty()) update_condition_nodes();
   // Deviation the particles shed last step joins the grid field now.
   if (std::any_of(node_pending_.begin(), node_pending_.end(), [](double e) { return e != 0; })) {
     parallel_for(node_heat_.size(), [&](std::size_t i) {
@@ -573,6 +608,38 @@ void ThermalPhysics::shed_to_grid() {
   });
 }
 
+/// A particle temperature condition holds, besides its particles, the nodes those particles make
+/// up at least half of (by volume): the surface's own nodes, wherever the material has moved it.
+/// Resetting the particles alone is not enough: the reset heat enters their nodes at each
+/// projection, and a neighbour's sub-grid deviation, measured against those nodes, sees only
+/// their loss during the step — it kept a frozen layer at −10 °C under a 10 °C surface layer while
+/// the heat passed under it to the layers below. Held nodes change by nothing during the step.
+void ThermalPhysics::update_condition_nodes() {
+  const auto& st = kernel_->transfer().stencil();
+  const int K = st.per_particle();
+  const auto vol = volume_.values();
+  std::vector<double> share(node_volume_.size());
+  for (auto& bc : particle_T_) {
+    std::fill(share.begin(), share.end(), 0.0);
+    bc.nodes.clear();
+    for (std::size_t p : bc.particles) {
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      for (int k = 0; k < K; ++k) share[nodes[k]] += vol[p] * w[k];
+    }
+    for (std::size_t p : bc.particles) {
+      const auto* nodes = st.nodes(p);
+      for (int k = 0; k < K; ++k) {
+        const std::size_t i = nodes[k];
+        if (share[i] > 0 && share[i] >= 0.5 * node_volume_[i]) {
+          bc.nodes.push_back(i);
+          share[i] = 0;  // listed once
+        }
+      }
+    }
+  }
+}
+
 /// Particle temperature conditions: the particles are reset to the value (the grid is
 /// re-derived from the particles at the next step); the heat that takes counts as boundary heat.
 void ThermalPhysics::apply_particle_dirichlet(double time, bool count_heat) {
@@ -680,6 +747,7 @@ std::vector<std::pair<std::string, double>> ThermalPhysics::statistics() const {
 }
 
 FROSTMPM_REGISTER(Physics, ThermalPhysics)
+FROSTMPM_REGISTER_BOUNDARY_TYPES(ThermalPhysics)
 
 }  // namespace frostmpm::thermal
 

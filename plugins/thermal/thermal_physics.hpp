@@ -25,6 +25,7 @@
 
 #include "enthalpy_table.hpp"
 #include "frostmpm/linalg/sparse_system.hpp"
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
 #include "frostmpm/physics/kernel.hpp"
@@ -47,7 +48,8 @@ class ThermalPhysics final : public Physics {
 
   ParamSchema material_schema() const override { return thermal::material_schema(); }
   std::vector<ModelSlot> material_models() const override { return {{"sfcc", SfccModel::kKind, true}}; }
-  std::vector<std::string> boundary_types() const override { return {"temperature", "heat_flux", "convective"}; }
+  static std::vector<BoundaryType> boundary_type_docs();
+  std::vector<std::string> boundary_types() const override { return boundary_type_names(boundary_type_docs()); }
 
   void setup(Kernel<kDim>& kernel) override;
   std::vector<Stage> stages() override;
@@ -71,6 +73,7 @@ class ThermalPhysics final : public Physics {
     std::vector<std::size_t> particles;
     TimeFunction value;
     std::string label;
+    std::vector<std::size_t> nodes;  ///< the nodes the particles make up most of (update_condition_nodes)
   };
   /// A boundary value at time t; a value that is not finite stops the run (NumericalBlowUp)
   /// naming the condition, a place on it, the time and the step.
@@ -101,6 +104,7 @@ class ThermalPhysics final : public Physics {
   std::vector<std::unique_ptr<EnthalpyTable>> tables_;
   std::vector<NodeCondition> fixed_T_, flux_, convective_;
   std::vector<ParticleCondition> particle_T_;
+  void update_condition_nodes();
   /// A heat_flux or convective condition on particles: the surface they stand for, and the node
   /// condition (in flux_ or convective_) whose nodes and areas follow from them.
   struct ParticleSurface {

@@ -22,7 +22,7 @@ const std::map<std::string, std::string> kScenes = {
     {"TC", "configs/verification/terzaghi_consolidation.yaml"}, {"MA", "configs/verification/mandel.yaml"},
     {"RF", "configs/paper/rock_freezing.yaml"},          {"PF", "configs/verification/prandtl_footing.yaml"},
     {"RS", "configs/verification/reissner_footing.yaml"}, {"IS", "configs/verification/infinite_slope.yaml"},
-    {"GC", "configs/verification/granular_collapse.yaml"}};
+    {"GC", "configs/verification/granular_collapse.yaml"}, {"TS", "configs/paper/thaw_slump.yaml"}};
 
 struct Case {
   int line = 0;

@@ -414,12 +414,41 @@ TEST_CASE("describe: a mistyped kind gets a suggestion, a kernel section says wh
   CHECK(r.exit_code == 2);
   CHECK(r.output.find("unknown kind 'sfc'; did you mean 'sfcc'?") != std::string::npos);
   CHECK(r.output.find("plugin path") == std::string::npos);  // not blamed on the plugin folders
-  r = run_frostmpm("describe boundary_conditions/temperature");
+  r = run_frostmpm("describe regions");
   INFO(r.output);
   CHECK(r.exit_code == 2);
-  CHECK(r.output.find("'boundary_conditions' is a scene section whose keys depend on the physics") != std::string::npos);
+  CHECK(r.output.find("'regions' is a scene section whose keys depend on the physics") != std::string::npos);
   CHECK(r.output.find("docs/config-reference.md") != std::string::npos);
   CHECK(r.output.find("Described here: grid, time, output, checkpoint") != std::string::npos);
+  r = run_frostmpm("describe boundary_conditions/tempreature");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("unknown boundary_conditions type 'tempreature'; did you mean 'temperature'?") != std::string::npos);
+}
+
+TEST_CASE("describe boundary_conditions: every physics' condition types with their keys, units and ranges", "[cli]") {
+  auto r = run_frostmpm("describe boundary_conditions/temperature");
+  INFO(r.output);
+  CHECK(r.exit_code == 0);
+  CHECK(r.output.find("boundary_conditions/temperature — a prescribed temperature") != std::string::npos);
+  CHECK(r.output.find("from frostmpm-thermal") != std::string::npos);
+  CHECK(r.output.find("YAML: boundary_conditions: [{type: temperature,") != std::string::npos);
+  CHECK(r.output.find("value  real  degC  required  [-10000, 10000]") != std::string::npos);
+  r = run_frostmpm("describe boundary_conditions");
+  INFO(r.output);
+  CHECK(r.exit_code == 0);
+  // One entry per type of every shipped physics, each naming its plugin.
+  for (const char* type : {"temperature", "heat_flux", "convective", "pore_pressure", "water_flux", "fixed", "roller",
+                           "velocity", "traction", "surcharge", "rigid_plate", "footing", "friction"})
+    CHECK(r.output.find(std::string("boundary_conditions/") + type + " — ") != std::string::npos);
+  CHECK(r.output.find("friction_angle  real  degree  required  [0, 90)") != std::string::npos);
+  // A type of a physics the scene does not enable says which physics it belongs to.
+  r = run_frostmpm("check " + source_dir() + "/configs/verification/conduction_erf.yaml" +
+                   " --set 'boundary_conditions.0={type: pore_pressure, nodes: {face: y_max}, value: 0}'");
+  INFO(r.output);
+  CHECK(r.exit_code == 2);
+  CHECK(r.output.find("boundary condition type 'pore_pressure' belongs to the physics 'hydraulic', which this scene "
+                      "does not enable") != std::string::npos);
 }
 
 TEST_CASE("describe grid, time, output and checkpoint: the kernel's sections with units, defaults and ranges",

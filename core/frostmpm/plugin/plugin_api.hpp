@@ -9,6 +9,7 @@
 
 #include <boost/dll/alias.hpp>
 
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/plugin/abi_tag.hpp"
 #include "frostmpm/plugin/registry.hpp"
 
@@ -48,6 +49,15 @@ struct AutoRegister {
 #define FROSTMPM_REGISTER(Interface, Class)                                                     \
   static const ::frostmpm::plugin_detail::AutoRegister FROSTMPM_CONCAT(frostmpm_reg_, __LINE__)( \
       [](::frostmpm::Registrar& r) { r.add<Interface, Class>(); });
+
+/// Registers the boundary-condition types Class describes (static std::vector<BoundaryType>
+/// boundary_type_docs(), frostmpm/physics/boundary_type.hpp) for `describe` and the reference.
+#define FROSTMPM_REGISTER_BOUNDARY_TYPES(Class)                                                 \
+  static const ::frostmpm::plugin_detail::AutoRegister FROSTMPM_CONCAT(frostmpm_reg_, __LINE__)( \
+      [](::frostmpm::Registrar& r) {                                                           \
+        for (auto& t : Class::boundary_type_docs())                                            \
+          r.add_description(::frostmpm::BoundaryType::kKind, t.name, t.doc, t.keys);           \
+      });
 
 /// The plugin's info record and its one versioned entry point.
 #define FROSTMPM_PLUGIN(plugin_name, plugin_version)                                          \

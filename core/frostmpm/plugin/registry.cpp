@@ -1,10 +1,17 @@
 #include "frostmpm/plugin/registry.hpp"
 
+#include "frostmpm/physics/boundary_type.hpp"
+
 #include <algorithm>
 
 #include "frostmpm/config/units.hpp"
 
 namespace frostmpm {
+
+namespace {
+/// " model '" — or " type '" for the boundary-condition types physics describe.
+const char* noun(const std::string& kind) { return kind == BoundaryType::kKind ? " type '" : " model '"; }
+}  // namespace
 
 void Registry::add(RegistryEntry entry) {
   auto& by_name = kinds_[entry.kind];
@@ -35,7 +42,7 @@ const RegistryEntry& Registry::get(const std::string& kind, const std::string& n
                                    const SourceLocation& where) const {
   if (const RegistryEntry* e = find(kind, name)) return *e;
   const auto valid = names(kind);
-  std::string message = "unknown " + kind + " model '" + name + "'" + did_you_mean(name, valid);
+  std::string message = "unknown " + kind + noun(kind) + name + "'" + did_you_mean(name, valid);
   message += " Registered: " + (valid.empty() ? std::string("(none; is the plugin path right?)") : join(valid));
   message += ". Plugin folders searched: " + (searched_.empty() ? std::string("(none)") : join(searched_));
   throw InputError(where, message);
@@ -64,7 +71,7 @@ std::vector<const RegistryEntry*> Registry::entries(const std::string& kind) con
 }
 
 void Registrar::add_entry(RegistryEntry entry) {
-  const std::string owner = entry.kind + " model '" + entry.name + "'";
+  const std::string owner = entry.kind + noun(entry.kind) + entry.name + "'";
   entry.schema.check_defaults(owner);
   // A unit UDUNITS-2 cannot read would fail only once a scene gave that parameter a unit.
   for (const auto& spec : entry.schema.params())

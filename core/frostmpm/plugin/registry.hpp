@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,20 @@ class Registrar {
     entry.create = [](const ParamSet& p) -> std::shared_ptr<void> {
       return std::static_pointer_cast<void>(
           std::static_pointer_cast<Interface>(std::make_shared<Class>(p)));
+    };
+    add_entry(std::move(entry));
+  }
+
+  /// An entry that only describes (no factory): a boundary-condition type a physics owns, listed
+  /// by `describe` and the config reference under `kind`.
+  void add_description(std::string kind, std::string name, std::string doc, ParamSchema schema) {
+    RegistryEntry entry;
+    entry.kind = std::move(kind);
+    entry.name = std::move(name);
+    entry.doc = std::move(doc);
+    entry.schema = std::move(schema);
+    entry.create = [name = entry.kind + "/" + entry.name](const ParamSet&) -> std::shared_ptr<void> {
+      throw std::logic_error(name + " is a description, not a model");
     };
     add_entry(std::move(entry));
   }

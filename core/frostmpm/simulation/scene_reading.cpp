@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/scene/region.hpp"
 #include "frostmpm/simulation/run_budget.hpp"
 #include "frostmpm/simulation/simulation.hpp"
@@ -411,6 +412,13 @@ void Simulation::read_boundary_conditions(const ConfigNode& node) {
     const ConfigNode type = item.child("type");
     bc.type = type.as_string();
     if (!bc_owner_.count(bc.type)) {
+      // A type another physics owns: say which, so the fix is to enable it, not to rename.
+      if (const RegistryEntry* described = registry_.find(BoundaryType::kKind, bc.type))
+        for (const RegistryEntry* physics : registry_.entries("physics"))
+          if (physics->library == described->library)
+            throw type.error("boundary condition type '" + bc.type + "' belongs to the physics '" + physics->name +
+                             "', which this scene does not enable (add it under physics:). Types of the physics in "
+                             "this scene: " + join(types));
       throw type.error("unknown boundary condition type '" + bc.type + "'" + did_you_mean(bc.type, types) +
                        " Types of the physics in this scene: " + join(types));
     }
