@@ -11,6 +11,7 @@
     /usr/bin/python3 scripts/plot_paper.py footing_thermal OUT_0.2 OUT_0.1 [OUT_0.05] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py footing OUT_unthawed OUT_thawing OUT_prethawed [...] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py slump OUT [--png FILE] [--frame N]
+    /usr/bin/python3 scripts/plot_paper.py footing_rates OUT_2 OUT_1 OUT_0.5 OUT_0.25 [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
@@ -35,7 +36,10 @@ Prandtl–Reissner pressure of the thawed soil (Fig. 27), and each run's plastic
 at its last frame with the −1 and 0 °C lines (Figs. 25–26). slump: the thaw slump of Sec. 5.3.1
 (configs/paper/thaw_slump.yaml) at one frame (the last unless --frame): temperature, plastic
 deviatoric strain and displacement, each with the thaw front (S_l = ½) and the slope's initial
-surface (Figs. 20–22), and the thaw depths and displacements against time. Each OUT is a run folder (metrics.csv, fields.h5).
+surface (Figs. 20–22), and the thaw depths and displacements against time. footing_rates: the
+strip footing pushed at different speeds (Sec. 5.3.2, Fig. 28): for each run the plastic deviatoric
+strain at d/B = 0.5, 1 and 1.5 with the 0 and −1 °C lines, and the footing pressures against d/B.
+Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
 """
@@ -447,11 +451,45 @@ def slump(folder, png, frame):
     frostplot.save(fig, png)
 
 
+def footing_rates(folders, png):
+    """Plastic deviatoric strain at d/B = 0.5, 1, 1.5 per run with the 0 and −1 °C lines (Fig. 28),
+    and footing pressure against d/B (one line per run)."""
+    width, depths = 1.2, (0.5, 1.0, 1.5)
+    fig, axes = plt.subplots(len(folders), len(depths) + 1, figsize=(4.2 * (len(depths) + 1), 3.0 * len(folders)),
+                             squeeze=False)
+    for row, folder in zip(axes, folders):
+        name = os.path.basename(folder.rstrip("/"))
+        m = metrics(folder)
+        frames = frostplot.read_fields.read_frames(folder)
+        times = np.array([fr["time"] for fr in frames])
+        reached = float(np.max(m["footing_displacement"])) / width
+        for ax, target in zip(row[:-1], depths):
+            if target > reached + 0.05:  # the run stopped before (a blow-up): say so, draw nothing
+                ax.text(0.5, 0.5, f"{name}: stopped at d/B = {reached:.2f}", ha="center", va="center",
+                        transform=ax.transAxes)
+                ax.set_axis_off()
+                continue
+            # the frame whose time is nearest to the row where the footing reached target × B
+            t = np.interp(target * width, m["footing_displacement"], m["time_s"])
+            fr = frames[int(np.argmin(np.abs(times - t)))]
+            d = np.interp(fr["time"], m["time_s"], m["footing_displacement"]) / width
+            frostplot.field_panel(ax, fig, fr, "plastic_deviatoric_strain", levels=np.linspace(0, 1, 11),
+                                  label="plastic deviatoric strain")
+            x, y = fr["coordinates"][:, 0], fr["coordinates"][:, 1]
+            T = fr["fields"]["temperature"]
+            if T.min() < -1 < T.max():
+                ax.tricontour(x, y, T, levels=[-1, 0], colors=["r", "r"], linewidths=1, linestyles=["--", "-"])
+            ax.set(xlim=(0, 5), ylim=(1.5, 6.6), title=f"{name}: d/B = {d:.2f}")
+        row[-1].plot(m["footing_displacement"] / width, m["footing_pressure"] / 1e3)
+        row[-1].set(xlabel="d / B", ylabel="footing pressure [kPa]", title=name)
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
-                                                      "footing_thermal", "footing", "slump"])
+                                                      "footing_thermal", "footing", "slump", "footing_rates"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -475,6 +513,8 @@ def main():
         footing(args.folders, png)
     elif args.figure == "slump":
         slump(args.folders[0], png, args.frame)
+    elif args.figure == "footing_rates":
+        footing_rates(args.folders, png)
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

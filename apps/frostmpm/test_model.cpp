@@ -139,6 +139,13 @@ std::vector<std::string> check_mechanical(const std::string& name, const Registr
   return check_mechanical_model_contract(cases, o.samples);
 }
 
+/// The refusal of a kind with no contract to check (physics, boundary-condition types).
+InputError no_contract_check(const std::string& kind) {
+  return InputError("test-model: no contract check for kind '" + kind + "'; it checks " + SfccModel::kKind + ", " +
+                    RelativePermeabilityModel::kKind + ", " + AbsolutePermeabilityModel::kKind + " and " +
+                    MechanicalModel::kKind + " models");
+}
+
 /// Builds the model and runs the contract check of its kind.
 std::vector<std::string> check(const std::string& kind, const std::string& name, const Registry& registry,
                                const ParamSet& params, const TestModelOptions& o, std::ostream& out) {
@@ -163,9 +170,7 @@ std::vector<std::string> check(const std::string& kind, const std::string& name,
     return check_absolute_permeability_contract(*registry.create<AbsolutePermeabilityModel>(name, params, where),
                                                 o.samples);
   }
-  throw InputError("test-model: no contract check for kind '" + kind + "'; it checks " + SfccModel::kKind + ", " +
-                   RelativePermeabilityModel::kKind + ", " + AbsolutePermeabilityModel::kKind + " and " +
-                   MechanicalModel::kKind + " models");
+  throw no_contract_check(kind);
 }
 
 }  // namespace
@@ -179,6 +184,9 @@ int cmd_test_model(const TestModelOptions& o, std::ostream& out) {
   const auto slash = o.target.find('/');
   if (slash == std::string::npos) throw InputError("test-model: expected KIND/NAME, e.g. sfcc/exponential");
   const std::string kind = o.target.substr(0, slash), name = o.target.substr(slash + 1);
+  if (kind != SfccModel::kKind && kind != RelativePermeabilityModel::kKind && kind != AbsolutePermeabilityModel::kKind &&
+      kind != MechanicalModel::kKind)
+    throw no_contract_check(kind);
   const RegistryEntry& entry = registry.get(kind, name, {"test-model", "", 0, 0});
   const Parameters params = read_parameters(entry, o.settings, o.target);
 

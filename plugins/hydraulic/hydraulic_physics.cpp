@@ -120,7 +120,6 @@ void HydraulicPhysics::setup(Kernel<kDim>& sim) {
 namespace {
 // Boundary values beyond these are typos or overflow, refused at setup (Pa and m/s).
 constexpr double kMaxPressure = 1e10, kMaxWaterFlux = 1e3;
-constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
 }  // namespace
 
 std::vector<BoundaryType> HydraulicPhysics::boundary_type_docs() {
@@ -128,15 +127,13 @@ std::vector<BoundaryType> HydraulicPhysics::boundary_type_docs() {
   types[0].name = "pore_pressure";
   types[0].doc = "a prescribed pore pressure (Eq. 19) on faces, node boxes or particles; on particles it holds the nodes "
                  "they make up at least half of, following the material as it moves (a drained surface inside the grid)";
-  types[0].keys.real("value", "-", std::string("the pressure [Pa], or with hydrostatic: true the water table's elevation "
-                                               "[m], a time function") + kTimeFunction)
-      .at_least(-kMaxPressure).at_most(kMaxPressure);
+  time_function_key(types[0].keys, "value", "-",
+                    "the pressure [Pa], or with hydrostatic: true the water table's elevation [m]", kMaxPressure);
   types[0].keys.boolean("hydrostatic", "p = ρ_l g (h − y) below the water table h given as value (a suction above it)")
       .defaults_to(false);
   types[1].name = "water_flux";
   types[1].doc = "Darcy flux flowing into the domain (Eq. 22) through a face";
-  types[1].keys.real("value", "m/s", std::string("the flux into the domain, a time function") + kTimeFunction)
-      .at_least(-kMaxWaterFlux).at_most(kMaxWaterFlux);
+  time_function_key(types[1].keys, "value", "m/s", "the flux into the domain", kMaxWaterFlux);
   return types;
 }
 

@@ -63,16 +63,11 @@ int read_axis(const ConfigNode& node) {
   throw node.error("unknown component '" + c + "'; valid: x, y" + std::string(Dim == 3 ? ", z" : ""));
 }
 
-constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
-
 /// The components x, y, z of a condition's value, each a time function in `unit`.
 void component_keys(ParamSchema& keys, const std::string& unit, const std::string& what, double bound) {
   for (int d = 0; d < 3; ++d)
-    keys.real(axis_name(d), unit, what + " along " + axis_name(d) + (d == 2 ? " (3-D only)" : "") + ", a time function" +
-                                      kTimeFunction)
-        .optional("not prescribed")
-        .at_least(-bound)
-        .at_most(bound);
+    time_function_key(keys, axis_name(d), unit, what + " along " + axis_name(d) + (d == 2 ? " (3-D only)" : ""), bound)
+        .optional("not prescribed");
 }
 
 }  // namespace
@@ -90,23 +85,19 @@ std::vector<BoundaryType> mechanical_boundary_types() {
   component_keys(t[2].keys, "m/s", "the velocity", kMaxVelocity);
   t[3].name = "traction";
   t[3].doc = "force per area on the material, tension positive (faces): normal and shear, or components";
-  t[3].keys.real("normal", "Pa", std::string("along the face's outward normal, a time function") + kTimeFunction)
-      .optional("none").at_least(-kMaxTraction).at_most(kMaxTraction);
-  t[3].keys.real("shear", "Pa", std::string("along the face (2-D), a time function") + kTimeFunction)
-      .optional("none").at_least(-kMaxTraction).at_most(kMaxTraction);
+  time_function_key(t[3].keys, "normal", "Pa", "along the face's outward normal", kMaxTraction).optional("none");
+  time_function_key(t[3].keys, "shear", "Pa", "along the face (2-D)", kMaxTraction).optional("none");
   component_keys(t[3].keys, "Pa", "the traction", kMaxTraction);
   t[4].name = "surcharge";
   t[4].doc = "a pressure pushing into the material (faces, or particles, whose outward normal is then given; on "
              "particles it follows the material as it moves)";
-  t[4].keys.real("value", "Pa", std::string("the pressure, a time function") + kTimeFunction)
-      .at_least(-kMaxTraction).at_most(kMaxTraction);
+  time_function_key(t[4].keys, "value", "Pa", "the pressure", kMaxTraction);
   t[4].keys.reals("normal", "-", "on particles: their outward normal along an axis, e.g. [0, 1]")
       .optional("a face's own");
   t[5].name = "rigid_plate";
   t[5].doc = "a rigid frictionless plate on a face carrying the total force into the material; its nodes move as one "
              "along the face's normal";
-  t[5].keys.real("force", "N/m", std::string("the total force (per m in 2-D), a time function") + kTimeFunction)
-      .at_least(-1e12).at_most(1e12);
+  time_function_key(t[5].keys, "force", "N/m", "the total force (per m in 2-D)", 1e12);
   t[6].name = "footing";
   t[6].doc = "a rigid footing driven at a prescribed velocity along one axis (a node box, which moves with it): the "
              "nodes inside it follow it; footing_* probes report its force and pressure";

@@ -125,7 +125,6 @@ std::vector<Stage> ThermalPhysics::stages() {
 namespace {
 // Boundary values beyond these are typos or overflow, refused at setup (°C and W/m²).
 constexpr double kMaxTemperature = 1e4, kMaxHeatFlux = 1e9;
-constexpr const char* kTimeFunction = ": a number, {table: [[t, v], ...]} or {expression: \"...t...\"}";
 }  // namespace
 
 std::vector<BoundaryType> ThermalPhysics::boundary_type_docs() {
@@ -133,19 +132,16 @@ std::vector<BoundaryType> ThermalPhysics::boundary_type_docs() {
   types[0].name = "temperature";
   types[0].doc = "a prescribed temperature (Eq. 20) on faces, node boxes or particles; on particles it holds them and the "
                  "nodes they make up at least half of, following the material as it moves";
-  types[0].keys.real("value", "degC", std::string("the temperature, a time function") + kTimeFunction)
-      .at_least(-kMaxTemperature).at_most(kMaxTemperature);
+  time_function_key(types[0].keys, "value", "degC", "the temperature", kMaxTemperature);
   types[1].name = "heat_flux";
   types[1].doc = "heat flowing into the domain (Eq. 23) through a face, or through the surface particles stand for";
-  types[1].keys.real("value", "W/m^2", std::string("the flux into the domain, a time function") + kTimeFunction)
-      .at_least(-kMaxHeatFlux).at_most(kMaxHeatFlux);
+  time_function_key(types[1].keys, "value", "W/m^2", "the flux into the domain", kMaxHeatFlux);
   types[1].keys.real("area", "m^2", "on particles only: the surface they stand for (per m in 2-D), shared by volume")
       .optional("a face's own area").above(0).at_most(1e6);
   types[2].name = "convective";
   types[2].doc = "h (T_a − T) into the domain (Eq. 24) through a face, or through the surface particles stand for";
   types[2].keys.real("h", "W/(m^2 K)", "heat transfer coefficient").above(0);
-  types[2].keys.real("ambient", "degC", std::string("the ambient temperature T_a, a time function") + kTimeFunction)
-      .at_least(-kMaxTemperature).at_most(kMaxTemperature);
+  time_function_key(types[2].keys, "ambient", "degC", "the ambient temperature T_a", kMaxTemperature);
   types[2].keys.real("area", "m^2", "on particles only: the surface they stand for (per m in 2-D), shared by volume")
       .optional("a face's own area").above(0).at_most(1e6);
   return types;

@@ -180,4 +180,7 @@ TEST_CASE("test-model flags a deliberately broken model, one line per violated r
   CHECK(r.exit_code == 2);
   CHECK(has(r.output, "no contract check for kind 'physics'; it checks sfcc, relative_permeability, "
                       "absolute_permeability and mechanical_model models"));
+  r = run_frostmpm("test-model boundary_conditions/temperature");  // a description, not a model
+  CHECK(r.exit_code == 2);
+  CHECK(has(r.output, "no contract check for kind 'boundary_conditions'"));
 }

@@ -19,6 +19,11 @@ struct BoundaryType {
   ParamSchema keys;   ///< its keys besides type, name and the target
 };
 
+/// Declares a key whose value is a time function (a number, a table or an expression of t, read
+/// by TimeFunction::read) of magnitude at most `bound`: `what` says what it is.
+ParamSpec& time_function_key(ParamSchema& keys, const std::string& name, const std::string& unit,
+                             const std::string& what, double bound);
+
 /// The type called `name` among `types` (a physics' own list; std::out_of_range if absent).
 const BoundaryType& boundary_type(const std::vector<BoundaryType>& types, const std::string& name);
 /// Their `type:` names, in order.
