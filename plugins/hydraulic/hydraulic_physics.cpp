@@ -185,20 +185,9 @@ void HydraulicPhysics::update_pressure_nodes(const std::vector<double>& node_vol
   if (!node_volume.empty()) {
     const auto& st = kernel_->transfer().stencil();
     const auto vol = volume_.values();
-    const int K = st.per_particle();
-    std::vector<double> share(node_volume.size());
-    for (auto& bc : pressure_bcs_) {
-      if (bc.particles.empty()) continue;
-      std::fill(share.begin(), share.end(), 0.0);
-      for (std::size_t p : bc.particles) {
-        const auto* nodes = st.nodes(p);
-        const auto* w = st.weights(p);
-        for (int k = 0; k < K; ++k) share[nodes[k]] += vol[p] * w[k];
-      }
-      bc.nodes.clear();
-      for (std::size_t i = 0; i < share.size(); ++i)
-        if (share[i] > 0 && share[i] >= 0.5 * node_volume[i]) bc.nodes.push_back(i);
-    }
+    std::vector<double> share;
+    for (auto& bc : pressure_bcs_)
+      if (!bc.particles.empty()) bc.nodes = nodes_made_up_by(bc.particles, st, vol, node_volume, share);
   }
   pressure_nodes_.clear();
   for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());

@@ -612,28 +612,8 @@ void ThermalPhysics::shed_to_grid() {
 /// the heat passed under it to the layers below. Held nodes change by nothing during the step.
 void ThermalPhysics::update_condition_nodes() {
   const auto& st = kernel_->transfer().stencil();
-  const int K = st.per_particle();
   const auto vol = volume_.values();
-  std::vector<double> share(node_volume_.size());
-  for (auto& bc : particle_T_) {
-    std::fill(share.begin(), share.end(), 0.0);
-    bc.nodes.clear();
-    for (std::size_t p : bc.particles) {
-      const auto* nodes = st.nodes(p);
-      const auto* w = st.weights(p);
-      for (int k = 0; k < K; ++k) share[nodes[k]] += vol[p] * w[k];
-    }
-    for (std::size_t p : bc.particles) {
-      const auto* nodes = st.nodes(p);
-      for (int k = 0; k < K; ++k) {
-        const std::size_t i = nodes[k];
-        if (share[i] > 0 && share[i] >= 0.5 * node_volume_[i]) {
-          bc.nodes.push_back(i);
-          share[i] = 0;  // listed once
-        }
-      }
-    }
-  }
+  for (auto& bc : particle_T_) bc.nodes = nodes_made_up_by(bc.particles, st, vol, node_volume_, condition_share_);
 }
 
 /// Particle temperature conditions: the particles are reset to the value (the grid is

@@ -105,6 +105,7 @@ class ThermalPhysics final : public Physics {
   std::vector<NodeCondition> fixed_T_, flux_, convective_;
   std::vector<ParticleCondition> particle_T_;
   void update_condition_nodes();
+  std::vector<double> condition_share_;  ///< scratch of update_condition_nodes
   /// A heat_flux or convective condition on particles: the surface they stand for, and the node
   /// condition (in flux_ or convective_) whose nodes and areas follow from them.
   struct ParticleSurface {

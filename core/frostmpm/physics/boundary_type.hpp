@@ -4,6 +4,8 @@
 // physics reads a condition's keys itself — values are time functions (a number, a table or an
 // expression of t) and the target (nodes or particles) is the kernel's — and accepts exactly the
 // keys named here (BoundaryCondition::accept_keys(type.keys.names())).
+#include <cstddef>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,27 @@ struct BoundaryType {
 /// by TimeFunction::read) of magnitude at most `bound`: `what` says what it is.
 ParamSpec& time_function_key(ParamSchema& keys, const std::string& name, const std::string& unit,
                              const std::string& what, double bound);
+
+/// The grid nodes that `particles` make up at least half of by volume, in ascending order:
+/// `share` is scratch of the nodes' size, `node_volume[i]` = Σ_p V_p S_ip over every particle.
+/// A condition on particles (a temperature or pore pressure held on a surface that is no grid
+/// face) holds these nodes: the surface's own, wherever the material has moved it.
+template <class Stencil>
+std::vector<std::size_t> nodes_made_up_by(const std::vector<std::size_t>& particles, const Stencil& stencil,
+                                          std::span<const double> volume, const std::vector<double>& node_volume,
+                                          std::vector<double>& share) {
+  share.assign(node_volume.size(), 0.0);
+  const int K = stencil.per_particle();
+  for (std::size_t p : particles) {
+    const auto* nodes = stencil.nodes(p);
+    const auto* w = stencil.weights(p);
+    for (int k = 0; k < K; ++k) share[nodes[k]] += volume[p] * w[k];
+  }
+  std::vector<std::size_t> held;
+  for (std::size_t i = 0; i < share.size(); ++i)
+    if (share[i] > 0 && share[i] >= 0.5 * node_volume[i]) held.push_back(i);
+  return held;
+}
 
 /// The type called `name` among `types` (a physics' own list; std::out_of_range if absent).
 const BoundaryType& boundary_type(const std::vector<BoundaryType>& types, const std::string& name);
