@@ -126,7 +126,8 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
            "the volumetric strain increment the constitutive model sees: each particle's own, or the "
            "volume-weighted mean over the particles in its grid cell (cell_average: a remedy for the volumetric "
            "locking of nearly incompressible or isochoric plastic flow, Mast et al. 2012, with the nodal forces "
-           "taking the cell's mean stress as B-bar does; the deviatoric part and the particle's volume stay its own)")
+           "taking the cell's mean stress as B-bar does and the particle's volume change following the cell's mean "
+           "as F-bar does; the deviatoric part stays its own)")
       .defaults_to("particle");
   s.choice("objective_rate", {"jaumann", "none"},
            "stress rate: Jaumann (objective, large rotations) or none (small-strain comparison)")
@@ -246,7 +247,10 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
 
   const std::size_t n = kernel.particle_count(), nodes = kernel.grid().node_count();
   strain_increment_.assign(6 * n, 0.0);
-  if (cell_average_) thermal_strain_.assign(n, 0.0);
+  if (cell_average_) {
+    thermal_strain_.assign(n, 0.0);
+    volume_ratio_.assign(n, 1.0);
+  }
   rotated_.assign(6 * n, 0.0);
   wave_modulus_.assign(n, 0.0);
   previous_T_.assign(n, 0.0);
@@ -492,6 +496,20 @@ void MechanicalPhysics<Dim>::update_stress() {
   const DensityView density = density_view();
   const bool two_phase = liquid_drag_.bound();
   long invalid = -1;
+  // The step's volume ratio J and the grains' expansion 1 + β_s ΔT give the new porosity from the
+  // conserved solid volume, and the porosity the skeleton's inertia.
+  auto close_volume = [&](std::size_t p, double J_ratio, double grain_expansion) {
+    const double new_phi = 1.0 - (1.0 - phi[p]) * grain_expansion / J_ratio;
+    if (!(new_phi > 0.0 && new_phi < 1.0) || !(J_ratio > 0)) {
+#pragma omp critical
+      invalid = invalid < 0 ? long(p) : std::min(invalid, long(p));
+      return;
+    }
+    phi[p] = new_phi;
+    double rho_m, skeleton, n_l;
+    density(p, rho_m, skeleton, n_l);
+    inertia[p] = mass_scaling_ * (two_phase ? skeleton : rho_m);
+  };
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t p = 0; p < n; ++p) {
     const auto L = transfer.vector_gradient_at(p, vn);
@@ -534,21 +552,19 @@ void MechanicalPhysics<Dim>::update_stress() {
       std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
       if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
     }
-    // The solid volume conserved (grains expand with β_s).
-    const double new_phi = 1.0 - (1.0 - phi[p]) * (1.0 + m.expansion * dT) / J_ratio;
-    if (!(new_phi > 0.0 && new_phi < 1.0) || !(J_ratio > 0)) {
-#pragma omp critical
-      invalid = invalid < 0 ? long(p) : std::min(invalid, long(p));
-    } else {
-      phi[p] = new_phi;
-    }
     for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
     for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
-    if (cell_average_) thermal_strain_[p] = thermal_strain;
     if (thermal) previous_T_[p] = T[p];
-    double rho_m, skeleton, n_l;
-    density(p, rho_m, skeleton, n_l);
-    inertia[p] = mass_scaling_ * (two_phase ? skeleton : rho_m);
+    if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
+      thermal_strain_[p] = thermal_strain;
+      volume_ratio_[p] = J_ratio;
+    } else {
+      close_volume(p, J_ratio, 1.0 + m.expansion * dT);
+    }
+  }
+  if (cell_average_) {
+    average_volumetric_strain();
+    average_volume_ratio(F, close_volume);
   }
   if (invalid >= 0) {
     std::ostringstream msg;
@@ -557,7 +573,6 @@ void MechanicalPhysics<Dim>::update_stress() {
         << " s, step " << kernel_->step() << " (dt = " << dt_ << " s); the step may be too large or the loads too high";
     throw NumericalBlowUp(msg.str());
   }
-  if (cell_average_) average_volumetric_strain();
 
   // The constitutive models: one batch per material range, cut into fixed chunks that the
   // threads share (every point is integrated on its own, so the chunks change no result).
@@ -671,6 +686,28 @@ void MechanicalPhysics<Dim>::average_volumetric_strain() {
     const double shift = (mean - (de[0] + de[1] + de[2])) / 3.0;
     for (int i = 0; i < 3; ++i) de[i] += shift;
   });
+}
+
+/// F-bar: every particle's volume ratio of the step replaced by the volume-weighted mean over
+/// its grid cell, J̄, and its F scaled by (J̄/J)^(1/Dim) in the plane of motion, so that det F —
+/// the particle's volume and porosity — follows the same cell mean as its volumetric strain.
+/// Without it the cell's total volume change is right but its particles' own volumes stay free
+/// to form a checkerboard, which drained soft soil lets run away. The cell's volume is kept.
+template <int Dim>
+template <class CloseVolume>
+void MechanicalPhysics<Dim>::average_volume_ratio(std::span<double> F, CloseVolume close_volume) {
+  average_over_cells([&](std::size_t p) { return volume_ratio_[p]; });
+  const std::size_t n = volume_ratio_.size();
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+  for (std::size_t p = 0; p < n; ++p) {
+    const double J = volume_ratio_[p], J_bar = cell_mean_[cell_of_[p]];
+    if (J > 0 && J_bar > 0) {
+      const double scale = std::pow(J_bar / J, 1.0 / Dim);
+      for (int a = 0; a < Dim; ++a)
+        for (int b = 0; b < Dim; ++b) F[9 * p + 3 * a + b] *= scale;
+    }
+    close_volume(p, J > 0 ? J_bar : J, 1.0 + 3.0 * thermal_strain_[p]);
+  }
 }
 
 template <int Dim>
@@ -1075,7 +1112,8 @@ void MechanicalPhysics<Dim>::removing_particles(const ParticleRemoval& removal) 
       removed_mass_ += rho_m * vol[p];  // [kg per m of thickness in 2-D]
     }
   }
-  for (auto* v : {&strain_increment_, &rotated_, &wave_modulus_, &previous_T_, &particle_mass_, &thermal_strain_})
+  for (auto* v : {&strain_increment_, &rotated_, &wave_modulus_, &previous_T_, &particle_mass_, &thermal_strain_,
+                  &volume_ratio_})
     removal.compact(*v);
   removal.compact(failed_);
   for (auto& c : traction_bcs_) removal.remap(c.particles);

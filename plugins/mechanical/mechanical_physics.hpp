@@ -150,6 +150,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<std::uint8_t> failed_;
   // ---- cell-averaged volumetric strain (only with cell_average_)
   std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step
+  std::vector<double> volume_ratio_;              ///< per particle: its kinematic volume ratio J of the step
   std::vector<std::size_t> cell_of_;              ///< per particle: its grid cell
   std::vector<double> cell_volume_, cell_mean_;   ///< per cell: Σ V and the volume-weighted mean (average_over_cells)
   std::vector<double> force_stress_;              ///< per particle: σ′ with its cell's mean trace, for the forces (predict())
@@ -200,6 +201,8 @@ class MechanicalPhysics final : public Physics {
   void map_to_particles();
   void set_geostatic_stress();
   void average_volumetric_strain();
+  template <class CloseVolume>
+  void average_volume_ratio(std::span<double> F, CloseVolume close_volume);
   template <class Value>
   void average_over_cells(Value value);
   [[noreturn]] void report_failure(std::size_t p) const;
