@@ -185,9 +185,8 @@ void HydraulicPhysics::update_pressure_nodes(const std::vector<double>& node_vol
   if (!node_volume.empty()) {
     const auto& st = kernel_->transfer().stencil();
     const auto vol = volume_.values();
-    std::vector<double> share;
     for (auto& bc : pressure_bcs_)
-      if (!bc.particles.empty()) bc.nodes = nodes_made_up_by(bc.particles, st, vol, node_volume, share);
+      if (!bc.particles.empty()) bc.nodes = nodes_made_up_by(bc.particles, st, vol, node_volume, condition_share_);
   }
   pressure_nodes_.clear();
   for (const auto& bc : pressure_bcs_) pressure_nodes_.insert(pressure_nodes_.end(), bc.nodes.begin(), bc.nodes.end());

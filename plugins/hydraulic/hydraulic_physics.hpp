@@ -160,6 +160,7 @@ class HydraulicPhysics final : public Physics {
   bool stabilized_ = false;
   // The pressure-boundary nodes (each once) and their rows as assembled, before the elimination
   std::vector<std::size_t> pressure_nodes_;
+  std::vector<double> condition_share_;  ///< scratch of update_pressure_nodes
   std::vector<double> boundary_rows_, boundary_rhs_;
   std::uint64_t projected_version_ = 0;  ///< stencil the nodal state belongs to
   bool grid_valid_ = false;
