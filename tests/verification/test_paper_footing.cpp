@@ -1,8 +1,9 @@
-// The strip footing on thawing ground of Yu et al. (2024, Sec. 5.3.2; configs/paper/strip_footing.yaml)
-// on the coarse 0.2 m mesh, to d/B = 0.3: which ground resists most. The paper finds unthawed >
-// thawing > pre-thawed (its Fig. 27). Here the resistance is read as the mean footing pressure
-// over the second cell of travel, d/B = 0.2–0.3 (the footing snaps to each node row it
-// crosses; docs/user-guide.md).
+// The strip footing on thawing ground of Yu et al. (2024, Sec. 5.3.2; configs/paper/strip_footing.yaml,
+// with its cell-averaged volumetric strain and its surface conditions on the top layer of
+// material points) on the coarse 0.2 m mesh, to d/B = 0.3: which ground resists most. The paper
+// finds unthawed > thawing > pre-thawed (its Fig. 27). Here the resistance is read as the mean
+// footing pressure over the second cell of travel, d/B = 0.2–0.3 (the footing snaps to each node
+// row it crosses; docs/user-guide.md).
 //
 // What the runs show, asserted so that a change to any of it is seen:
 //   - ground thawed beforehand (its temperature taken from the thermal run's last frame) is the
@@ -11,9 +12,9 @@
 //     than frozen ground, in the paper's order;
 //   - with it on (the paper's Eq. 7), the meltwater's volume deficit draws the pore pressure of
 //     the thawing zone to about −1 MPa, which raises the effective stress and the frictional
-//     strength (φ′ = 30°) above that of the undrained frozen ground. docs/verification.md
-//     discusses why the paper's code measures the opposite (its resistance counts the pore
-//     pressure, and its ice cohesion never softens).
+//     strength (φ′ = 30°) above that of the undrained frozen ground (to d/B = 1 in the full
+//     run). docs/verification.md discusses why the paper's code measures the opposite (its
+//     resistance counts the pore pressure, and its ice cohesion never softens).
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -66,8 +67,9 @@ TEST_CASE("strip footing on frozen, thawing and thawed ground: the order of thei
   CHECK(thawed < no_melt_suction);
   CHECK(no_melt_suction < unthawed);
   CHECK(unthawed < thawing);
-  // The margins are wide: each at least 15 % apart.
+  // The margins: each at least 15 % apart, frozen and thawing ground at least 10 % (they read
+  // 1.92 and 2.28 MPa).
   CHECK(thawed < 0.85 * no_melt_suction);
   CHECK(no_melt_suction < 0.85 * unthawed);
-  CHECK(unthawed < 0.85 * thawing);
+  CHECK(unthawed < 0.90 * thawing);
 }
