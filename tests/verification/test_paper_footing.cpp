@@ -11,7 +11,7 @@
 //   - with the melting source of the pore-water balance switched off, thawing ground is weaker
 //     than frozen ground, in the paper's order;
 //   - with it on (the paper's Eq. 7), the meltwater's volume deficit draws the pore pressure of
-//     the thawing zone to about −1 MPa, which raises the effective stress and the frictional
+//     the thawing zone to −0.1 to −0.6 MPa, which raises the effective stress and the frictional
 //     strength (φ′ = 30°) above that of the undrained frozen ground (to d/B = 1 in the full
 //     run). docs/verification.md discusses why the paper's code measures the opposite (its
 //     resistance counts the pore pressure, and its ice cohesion never softens).
