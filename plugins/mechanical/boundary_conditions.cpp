@@ -12,7 +12,8 @@
 //        material may leave but not cross, sliding along it against Coulomb friction μ = tan δ
 //   {type: footing, nodes: {box: ...}, y: v(t), contact: rough|smooth}  a rigid footing driven
 //        at a prescribed velocity along one axis: the nodes inside its box, which moves with it,
-//        follow it (rough: the other components held at 0); footing_* probes report it
+//        and behind its face up to the grid's edge follow it (rough: the other components held
+//        at 0); footing_* probes report it
 // Velocity conditions also hold the intermediate velocity (paper Sec. 4.2: v* = v^{k+1} on
 // ∂Ω_v) and record the force they exert on the material (reaction probes). Where conditions
 // meet on a node component:
@@ -100,7 +101,8 @@ std::vector<BoundaryType> mechanical_boundary_types() {
   time_function_key(t[5].keys, "force", "N/m", "the total force (per m in 2-D)", 1e12);
   t[6].name = "footing";
   t[6].doc = "a rigid footing driven at a prescribed velocity along one axis (a node box, which moves with it): the "
-             "nodes inside it follow it; footing_* probes report its force and pressure";
+             "nodes inside it, and behind its face up to the grid's edge, follow it; footing_* probes report its "
+             "force and pressure";
   component_keys(t[6].keys, "m/s", "the footing's velocity (exactly one component; ramp it from 0)", kMaxVelocity);
   t[6].keys.choice("contact", {"rough", "smooth"}, "rough: the other components held at 0; smooth: frictionless")
       .defaults_to("rough");
@@ -381,7 +383,7 @@ void MechanicalPhysics<Dim>::read_footing(BoundaryCondition& bc, const Kernel<Di
       f.contact_area *= std::max(0.0, std::min(f.hi[d], grid.upper()[d]) - std::max(f.lo[d], grid.origin[d]));
 
   // Every node it will cover: no other condition may prescribe something else there.
-  auto swept_lo = f.lo, swept_hi = f.hi;
+  auto [swept_lo, swept_hi] = footing_body(f, grid);
   swept_lo[f.axis] += u_min;
   swept_hi[f.axis] += u_max;
   for (std::size_t i : box_nodes<Dim>(grid, swept_lo, swept_hi))
@@ -405,6 +407,23 @@ void MechanicalPhysics<Dim>::read_footing(BoundaryCondition& bc, const Kernel<Di
   footings_.push_back(f);
 }
 
+/// The footing's body at t = 0: its box, reaching back from its leading face to the grid's edge
+/// behind it. Material cannot pass over a rigid footing; a body only as tall as the box would
+/// leave the points its face passes (as it snaps from node row to node row) above it on free
+/// nodes straddling held ones, where they add forces of their own and can be thrown off.
+template <int Dim>
+std::pair<std::array<double, Dim>, std::array<double, Dim>> MechanicalPhysics<Dim>::footing_body(
+    const FootingCondition& f, const UniformGrid<Dim>& grid) {
+  auto lo = f.lo, hi = f.hi;
+  // Far enough that the box still reaches the edge after the footing's whole travel.
+  const double reach = grid.upper()[f.axis] - grid.origin[f.axis];
+  if (f.direction < 0)
+    hi[f.axis] = std::max(hi[f.axis], grid.upper()[f.axis] + reach);
+  else
+    lo[f.axis] = std::min(lo[f.axis], grid.origin[f.axis] - reach);
+  return {lo, hi};
+}
+
 template <int Dim>
 void MechanicalPhysics<Dim>::place_footings() {
   for (auto& f : footings_) {
@@ -414,7 +433,7 @@ void MechanicalPhysics<Dim>::place_footings() {
     for (std::size_t i : c.nodes)
       for (int d = 0; d < Dim; ++d)
         if (constraint_owner_[i * Dim + d] == index) constraint_owner_[i * Dim + d] = kFree;
-    auto lo = f.lo, hi = f.hi;
+    auto [lo, hi] = footing_body(f, kernel_->grid());
     lo[f.axis] += f.displacement;
     hi[f.axis] += f.displacement;
     c.nodes = box_nodes<Dim>(kernel_->grid(), lo, hi);
@@ -542,6 +561,8 @@ std::optional<std::array<double, 3>> MechanicalPhysics<Dim>::reaction(const Boun
   template std::optional<std::array<double, 3>> MechanicalPhysics<D>::reaction(const BoundaryCondition&) const; \
   template void MechanicalPhysics<D>::read_footing(BoundaryCondition&, const Kernel<D>&);                 \
   template void MechanicalPhysics<D>::place_footings();                                                     \
+  template std::pair<std::array<double, D>, std::array<double, D>> MechanicalPhysics<D>::footing_body(        \
+      const FootingCondition&, const UniformGrid<D>&);                                                     \
   template std::optional<Physics::RigidBodyMotion> MechanicalPhysics<D>::rigid_body(const BoundaryCondition&) const;
 FROSTMPM_MECHANICAL_BOUNDARIES(2)
 FROSTMPM_MECHANICAL_BOUNDARIES(3)

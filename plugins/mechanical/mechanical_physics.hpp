@@ -181,8 +181,11 @@ class MechanicalPhysics final : public Physics {
   void tie_plates(std::vector<double>& v, double t, double dt, bool with_drag);
   /// Reads a footing condition (after the velocity conditions and plates, whose nodes it checks).
   void read_footing(BoundaryCondition& bc, const Kernel<Dim>& kernel);
-  /// Gives each footing the nodes inside its box where it now is (each step, before the stages).
+  /// Gives each footing the nodes of its body where it now is (each step, before the stages).
   void place_footings();
+  /// The nodes' region a footing holds at t = 0 (footing_body() in boundary_conditions.cpp).
+  static std::pair<std::array<double, Dim>, std::array<double, Dim>> footing_body(const FootingCondition& f,
+                                                                                  const UniformGrid<Dim>& grid);
   /// ρ_m, the skeleton's inertia per volume and n_l of particle p (S_l from the thermal physics, else 1).
   void densities(std::size_t p, double& rho_m, double& skeleton, double& n_l) const;
   /// densities() with what it reads fetched once, for loops over particles (a handle's values()
