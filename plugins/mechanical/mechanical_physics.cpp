@@ -510,58 +510,60 @@ void MechanicalPhysics<Dim>::update_stress() {
     density(p, rho_m, skeleton, n_l);
     inertia[p] = mass_scaling_ * (two_phase ? skeleton : rho_m);
   };
+  for_support<Dim>(transfer.stencil().per_particle(), [&](auto support) {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-  for (std::size_t p = 0; p < n; ++p) {
-    const auto L = transfer.vector_gradient_at(p, vn);
-    double* de = strain_increment_.data() + 6 * p;
-    double* rotated = rotated_.data() + 6 * p;
-    const auto& m = materials_[transfer.material(p)];
-    // Thermal strain of the grains: β_s ΔT / 3 on each normal component (β_s is volumetric).
-    const double dT = thermal ? T[p] - previous_T_[p] : 0.0;
-    const double thermal_strain = m.expansion * dT / 3.0;
-    // Kinematics: Δε, F ← (I + L Δt) F, the volume ratio and the rotated start stress.
-    double J_ratio = 0;
-    bool done = false;
-    if constexpr (Dim == 2)
-      done = plane_strain_kinematics(L, dt_, F.data() + 9 * p, de, J_ratio, jaumann_, sigma_start.data() + 6 * p,
-                                     rotated);
-    if (!done) {
-      tensor3::Mat l{}, W{};
-      for (int a = 0; a < Dim; ++a)
-        for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
-      tensor3::Mat sym{};
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
-      tensor3::from_matrix(sym, de);
-      double f[9];
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) {
-          double s = F[9 * p + 3 * a + b];
-          for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
-          f[3 * a + b] = s;
-        }
-      double increment[9];
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
-      J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
-                increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
-                increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
-      std::copy(f, f + 9, F.data() + 9 * p);
-      std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
-      if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
+    for (std::size_t p = 0; p < n; ++p) {
+      const auto L = transfer.vector_gradient_at(p, vn, support);
+      double* de = strain_increment_.data() + 6 * p;
+      double* rotated = rotated_.data() + 6 * p;
+      const auto& m = materials_[transfer.material(p)];
+      // Thermal strain of the grains: β_s ΔT / 3 on each normal component (β_s is volumetric).
+      const double dT = thermal ? T[p] - previous_T_[p] : 0.0;
+      const double thermal_strain = thermal ? m.expansion * dT / 3.0 : m.expansion * 0.0;  // its signed zero as before
+      // Kinematics: Δε, F ← (I + L Δt) F, the volume ratio and the rotated start stress.
+      double J_ratio = 0;
+      bool done = false;
+      if constexpr (Dim == 2)
+        done = plane_strain_kinematics(L, dt_, F.data() + 9 * p, de, J_ratio, jaumann_, sigma_start.data() + 6 * p,
+                                       rotated);
+      if (!done) {
+        tensor3::Mat l{}, W{};
+        for (int a = 0; a < Dim; ++a)
+          for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
+        tensor3::Mat sym{};
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
+        tensor3::from_matrix(sym, de);
+        double f[9];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) {
+            double s = F[9 * p + 3 * a + b];
+            for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
+            f[3 * a + b] = s;
+          }
+        double increment[9];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
+        J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
+                  increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
+                  increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
+        std::copy(f, f + 9, F.data() + 9 * p);
+        std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
+        if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
+      }
+      for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
+      for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
+      if (thermal) previous_T_[p] = T[p];
+      if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
+        thermal_strain_[p] = thermal_strain;
+        volume_ratio_[p] = J_ratio;
+      } else {
+        close_volume(p, J_ratio, 1.0 + m.expansion * dT);
+      }
     }
-    for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
-    for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
-    if (thermal) previous_T_[p] = T[p];
-    if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
-      thermal_strain_[p] = thermal_strain;
-      volume_ratio_[p] = J_ratio;
-    } else {
-      close_volume(p, J_ratio, 1.0 + m.expansion * dT);
-    }
-  }
+  });
   if (cell_average_) {
     average_volumetric_strain();
     average_volume_ratio(F, close_volume);
@@ -970,10 +972,12 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   const double h = kernel_->grid().min_spacing();
   const auto sigma = stress_.values();
   const auto shear = shear_.values();
-  double kinetic = 0, elastic = 0, limit = std::numeric_limits<double>::infinity();
+  // The stable step h / max(c + |v|): the fastest signal, divided into h once (rounded division
+  // is monotone, so this is min_p h / (c + |v|)_p to the bit).
+  double kinetic = 0, elastic = 0, fastest = 0;
   auto update = [&](auto support, auto with_trapezoid) {
     constexpr bool trapezoid = decltype(with_trapezoid)::value;
-#pragma omp parallel for schedule(static) reduction(+ : kinetic, elastic) reduction(min : limit) if (n >= kParallelMinimum)
+#pragma omp parallel for schedule(static) reduction(+ : kinetic, elastic) reduction(max : fastest) if (n >= kParallelMinimum)
     for (std::size_t p = 0; p < n; ++p) {
       elastic += vol[p] * elastic_energy_density(sigma.data() + 6 * p, wave_modulus_[p], shear[p]);
       const auto* nodes = st.nodes(p);
@@ -1002,14 +1006,13 @@ void MechanicalPhysics<Dim>::map_to_particles() {
       kinetic += 0.5 * vol[p] * inertia[p] * speed2;
       // The stable step of the state left (stable_time_step()'s limit, the same expression).
       const double c = inertia[p] > 0 ? std::sqrt(wave_modulus_[p] / inertia[p]) : 0.0;
-      const double speed = c + std::sqrt(speed2);
-      limit = std::min(limit, speed > 0 ? h / speed : std::numeric_limits<double>::infinity());
+      fastest = std::max(fastest, c + std::sqrt(speed2));
     }
   };
   for_support<Dim>(K, [&](auto support) {
     trapezoidal_ ? update(support, std::true_type{}) : update(support, std::false_type{});
   });
-  step_limit_ = limit;
+  step_limit_ = fastest > 0 ? h / fastest : std::numeric_limits<double>::infinity();
   step_limit_valid_ = true;
   // Each footing moves as its nodes moved the material under it this step.
   for (auto& f : footings_) {

@@ -90,10 +90,15 @@ class Transfer {
   /// (∇v)_ab = Σ_i v_ia ∂S_ip/∂x_b of a nodal vector field stored Dim values per node.
   template <class Nodal>
   std::array<std::array<double, Dim>, Dim> vector_gradient_at(std::size_t p, const Nodal& v) const {
+    return vector_gradient_at(p, v, stencil_.per_particle());
+  }
+  /// The same with the support size given, as std::integral_constant in hot loops (unrolled).
+  template <class Nodal, class Support>
+  std::array<std::array<double, Dim>, Dim> vector_gradient_at(std::size_t p, const Nodal& v, Support support) const {
     const auto* nodes = stencil_.nodes(p);
     const auto* g = stencil_.gradients(p);
     std::array<std::array<double, Dim>, Dim> out{};
-    for (int k = 0; k < stencil_.per_particle(); ++k)
+    for (int k = 0; k < support; ++k)
       for (int a = 0; a < Dim; ++a) {
         const double va = v[nodes[k] * Dim + a];
         for (int b = 0; b < Dim; ++b) out[a][b] += va * g[k * Dim + b];
