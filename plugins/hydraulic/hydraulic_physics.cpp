@@ -526,15 +526,42 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_ = {double(solves_), double(iterations_total_), double(iterations_max_), residual_max_};
   saved_scalars_.push_back(double(preconditioner_updates_));
   saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0, removed_water_});
+  saved_scalars_.insert(saved_scalars_.end(), {system_ ? 1.0 : 0.0, preconditioner_built_ ? 1.0 : 0.0,
+                                               refresh_due_ ? 1.0 : 0.0, double(iterations_after_refresh_)});
+  saved_groups_ = {double(graph_groups_.size())};
+  for (const auto& group : graph_groups_) {
+    saved_groups_.push_back(double(group.size()));
+    saved_groups_.insert(saved_groups_.end(), group.begin(), group.end());
+  }
+  saved_source_ = system_ ? system_->preconditioner_source() : PreconditionerSource{};
   return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
           {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
           {"nodes_with_material", &was_active_},
-          {"temperature_at_step_start", &T_prev_}};
+          {"temperature_at_step_start", &T_prev_},
+          {"pressure_graph_plate_rows", &saved_groups_},
+          {"preconditioner_built_from", &saved_source_.built},
+          {"preconditioner_refreshed_from", &saved_source_.refreshed}};
 }
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 9) throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 9");
+  if (s.size() != 13)
+    throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 13");
+  // The pressure system as it was: assemble() builds it with the saved plate rows and rebuilds
+  // the preconditioner from the values it was made from; the next solve starts from the carried Δp.
+  restore_system_ = s[9] != 0;
+  preconditioner_built_ = s[10] != 0;
+  refresh_due_ = s[11] != 0;
+  iterations_after_refresh_ = long(s[12]);
+  graph_groups_.clear();
+  if (!saved_groups_.empty()) {
+    std::size_t at = 1;
+    for (std::size_t g = 0; g < std::size_t(saved_groups_[0]); ++g) {
+      const std::size_t size = std::size_t(saved_groups_.at(at++));
+      graph_groups_.emplace_back();
+      for (std::size_t k = 0; k < size; ++k) graph_groups_.back().push_back(std::size_t(saved_groups_.at(at++)));
+    }
+  }
   removed_water_ = s[8];
   preconditioner_updates_ = long(s[4]);
   source_volume_ = s[5];
@@ -547,18 +574,13 @@ void HydraulicPhysics::restored() {
   // The nodal state came back with the kernel's carried node fields; it belongs to this stencil.
   projected_version_ = kernel_->transfer().version();
   grid_valid_ = true;
-  std::fill(dp_->begin(), dp_->end(), 0.0);
+  if (!restore_system_) std::fill(dp_->begin(), dp_->end(), 0.0);  // no solve yet: no first guess
 }
 
-/// The pressure system is built anew after a checkpoint, as a restart builds it: the matrix
-/// graph (a rigid plate's rows follow its nodes of the moment) and the preconditioner, with the
-/// refresh counters; the next solve starts from a zero increment, as a restart's does.
+/// Writing a checkpoint leaves the solver as it was (the checkpoint holds what rebuilds it).
 void HydraulicPhysics::checkpoint_written() {
-  std::fill(dp_->begin(), dp_->end(), 0.0);
-  system_.reset();
-  preconditioner_built_ = false;
-  refresh_due_ = false;
-  iterations_after_refresh_ = 0;
+  saved_source_ = {};  // the copies persistent_state() made
+  saved_groups_.clear();
 }
 
 std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const {

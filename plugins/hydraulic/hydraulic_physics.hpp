@@ -170,9 +170,18 @@ class HydraulicPhysics final : public Physics {
   StencilGraph compact_;  ///< coupled: the particle-stencil pattern of Q (graph_ is its square)
   std::unique_ptr<SparseSystem> system_;
   std::vector<double> values_;
-  bool preconditioner_built_ = false;  ///< for the current system (a restart builds a new one)
+  bool preconditioner_built_ = false;  ///< for the current system
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
   bool refresh_due_ = false;           ///< the iteration count grew by half since the last update
+  /// The rigid plates' rows the coupled graph was built with (group_rows() at the time).
+  std::vector<std::vector<std::size_t>> graph_groups_;
+  // The solver's state in a checkpoint: the graph's plate rows (flattened: count, then each
+  // group's size and rows) and the values the preconditioner was built and refreshed from. A
+  // restart builds the same system and preconditioner with them (assemble()), so that it
+  // continues bit for bit from any step.
+  std::vector<double> saved_groups_;
+  PreconditionerSource saved_source_;
+  bool restore_system_ = false;  ///< restored(): assemble() rebuilds the system from the saved state
 
   // ---- step and counters
   double time_ = 0, dt_ = 0;

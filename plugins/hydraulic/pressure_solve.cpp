@@ -35,7 +35,8 @@ void HydraulicPhysics::assemble() {
       // stencils apart (Q M⁻¹ Qᵀ), and every node near a rigid plate with every other (the plate
       // moves as one body); Q itself one stencil apart.
       const int reach = support_width(st.kind()) - 1;
-      graph_.build_lattice(kernel_->grid(), 2 * reach, group_rows());
+      if (!restore_system_) graph_groups_ = group_rows();
+      graph_.build_lattice(kernel_->grid(), 2 * reach, graph_groups_);
       graph_.build_scatter(st);
       compact_.build_lattice(kernel_->grid(), reach);
       compact_.build_scatter(st);
@@ -49,7 +50,13 @@ void HydraulicPhysics::assemble() {
     options.tolerance = params_.real("linear_tolerance");
     options.max_iterations = static_cast<int>(params_.integer("max_linear_iterations"));
     system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
-    preconditioner_built_ = false;
+    if (restore_system_) {  // a restart: the preconditioner the checkpointed run had (its flags came back)
+      if (!saved_source_.built.empty()) system_->restore_preconditioner(saved_source_);
+      restore_system_ = false;
+      saved_source_ = {};
+    } else {
+      preconditioner_built_ = false;
+    }
   }
   values_.assign(graph_.nonzeros(), 0.0);
   std::fill(rhs_.begin(), rhs_.end(), 0.0);

@@ -146,6 +146,7 @@ struct SparseSystem::Impl {
   RCP<Ifpack2Prec> ifpack2;   ///< jacobi / ilu
   RCP<MueLuPrec> muelu;       ///< multigrid
   bool have_preconditioner = false;
+  PreconditionerSource source;  ///< the values it was built and refreshed from
 
   Impl(std::vector<std::size_t> row_offsets, std::vector<int> column_indices, SolverOptions opts)
       : offsets(std::move(row_offsets)), columns(std::move(column_indices)),
@@ -289,7 +290,11 @@ struct SparseSystem::Impl {
         ifpack2->setParameters(params);
         ifpack2->initialize();
       }
-      ifpack2->compute();
+      ifpack2->compute();  // from the current values alone: every compute() is a refresh
+      if (!have_preconditioner)
+        source = {values, {}};
+      else
+        source.refreshed = values;
       problem->setRightPrec(ifpack2);
     } else if (kind == "multigrid") {
       Teuchos::ParameterList params;
@@ -327,6 +332,11 @@ struct SparseSystem::Impl {
       }
       if (!refreshed)
         muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
+      // A refresh depends on the aggregates and prolongators of the build and on the new values.
+      if (refreshed)
+        source.refreshed = values;
+      else
+        source = {values, {}};
       problem->setRightPrec(muelu);
     }
     have_preconditioner = true;
@@ -488,6 +498,32 @@ SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x,
 SolveStats SparseSystem::solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update,
                                double tolerance) {
   return impl_->solve(rhs, x, update, tolerance);
+}
+
+PreconditionerSource SparseSystem::preconditioner_source() const {
+  return impl_->have_preconditioner ? impl_->source : PreconditionerSource{};
+}
+
+void SparseSystem::restore_preconditioner(const PreconditionerSource& source) {
+  Impl& s = *impl_;
+  const std::size_t nnz = s.values.size();
+  if (source.built.size() != nnz || (!source.refreshed.empty() && source.refreshed.size() != nnz))
+    throw std::invalid_argument("SparseSystem::restore_preconditioner: expected " + std::to_string(nnz) +
+                                " values built from and none or as many refreshed from, got " +
+                                std::to_string(source.built.size()) + " and " +
+                                std::to_string(source.refreshed.size()));
+  if (s.n == 0 || s.options.preconditioner == "none") return;
+  const std::vector<double> current = s.values;
+  s.values = source.built;
+  s.upload_values();
+  s.build_preconditioner(false);
+  if (!source.refreshed.empty()) {
+    s.values = source.refreshed;
+    s.upload_values();
+    s.build_preconditioner(true);
+  }
+  s.values = current;
+  s.values_dirty = true;
 }
 
 }  // namespace frostmpm

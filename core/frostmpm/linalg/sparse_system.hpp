@@ -44,6 +44,14 @@ enum class PreconditionerUpdate {
   Rebuild,  ///< build it from scratch
 };
 
+/// The matrix values a preconditioner was built from and last refreshed from, in the order of
+/// the caller's column_indices (`refreshed` empty: not refreshed since it was built). They fix
+/// the preconditioner: SparseSystem::restore_preconditioner() builds the same one again, so a
+/// run resumed from a checkpoint that holds them solves as the uninterrupted run did.
+struct PreconditionerSource {
+  std::vector<double> built, refreshed;
+};
+
 /// Square sparse system A x = b with a fixed sparsity pattern: CSR, 0-based, global indices
 /// (local = global while the data are serial, see above).
 ///
@@ -95,6 +103,13 @@ class SparseSystem {
   /// while far from its solution).
   SolveStats solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update,
                    double tolerance = 0.0);
+
+  /// What the current preconditioner was made from (both empty when there is none).
+  PreconditionerSource preconditioner_source() const;
+  /// Builds the preconditioner from source.built and refreshes it from source.refreshed (if
+  /// given), as the solves that made it did; the system's current values stay as they are.
+  /// Throws std::invalid_argument for arrays of the wrong size.
+  void restore_preconditioner(const PreconditionerSource& source);
 
  private:
   struct Impl;
