@@ -29,8 +29,12 @@ void ThermalPhysics::build_graph() {
   system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
   for (auto* v : {&stiffness_, &free_stiffness_, &matrix_values_}) v->assign(graph_.nonzeros(), 0.0);
   for (auto* v : {&boundary_diagonal_, &boundary_load_, &residual_, &rhs_, &increment_, &K_times_T_,
-                  &K_times_increment_, &start_heat_, &start_T_, &node_T_before_})
+                  &K_times_increment_, &start_heat_, &start_T_})
     v->assign(nodes, 0.0);
+  // The last substep's start temperatures stay: a new graph (particles moved into other stencils,
+  // or a restart, which restored them) does not change the nodes, and the next first guess
+  // extrapolates from them. Zeroed, that guess would be twice the temperature.
+  if (node_T_before_.size() != nodes) node_T_before_.assign(nodes, 0.0);
   assembled_conductivity_.clear();  // a new graph is assembled in full
 }
 
