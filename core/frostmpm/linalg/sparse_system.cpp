@@ -290,11 +290,11 @@ struct SparseSystem::Impl {
         ifpack2->setParameters(params);
         ifpack2->initialize();
       }
-      ifpack2->compute();  // from the current values alone: every compute() is a refresh
-      if (!have_preconditioner)
-        source = {values, {}};
-      else
+      ifpack2->compute();  // from the current values alone
+      if (refresh)
         source.refreshed = values;
+      else
+        source = {values, {}};
       problem->setRightPrec(ifpack2);
     } else if (kind == "multigrid") {
       Teuchos::ParameterList params;
