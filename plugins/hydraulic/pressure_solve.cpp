@@ -51,7 +51,7 @@ void HydraulicPhysics::assemble() {
     options.max_iterations = static_cast<int>(params_.integer("max_linear_iterations"));
     system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
     if (restore_system_) {  // a restart: the preconditioner the checkpointed run had (its flags came back)
-      if (!saved_source_.built.empty()) system_->restore_preconditioner(saved_source_);
+      system_->restore_preconditioner(saved_source_);
       restore_system_ = false;
       saved_source_ = {};
     } else {

@@ -248,6 +248,8 @@ TEST_CASE("SparseSystem refills values on the same graph and reuses the precondi
 
     SparseSystem restored(grid.offsets, grid.columns, make_options(method, preconditioner));
     REQUIRE(restored.preconditioner_source().built.empty());
+    restored.restore_preconditioner(restored.preconditioner_source());  // none to restore: nothing happens
+    REQUIRE(restored.preconditioner_source().built.empty());
     restored.set_values(grid.values(9.0));
     restored.restore_preconditioner(source);
     REQUIRE(std::equal(restored.values().begin(), restored.values().end(), grid.values(9.0).begin()));  // kept

@@ -506,6 +506,7 @@ PreconditionerSource SparseSystem::preconditioner_source() const {
 
 void SparseSystem::restore_preconditioner(const PreconditionerSource& source) {
   Impl& s = *impl_;
+  if (source.built.empty() && source.refreshed.empty()) return;  // there was none ("none", or no solve yet)
   const std::size_t nnz = s.values.size();
   if (source.built.size() != nnz || (!source.refreshed.empty() && source.refreshed.size() != nnz))
     throw std::invalid_argument("SparseSystem::restore_preconditioner: expected " + std::to_string(nnz) +

@@ -107,8 +107,9 @@ class SparseSystem {
   /// What the current preconditioner was made from (both empty when there is none).
   PreconditionerSource preconditioner_source() const;
   /// Builds the preconditioner from source.built and refreshes it from source.refreshed (if
-  /// given), as the solves that made it did; the system's current values stay as they are.
-  /// Throws std::invalid_argument for arrays of the wrong size.
+  /// given), as the solves that made it did; the system's current values stay as they are. An
+  /// empty source (no preconditioner was built) does nothing. Throws std::invalid_argument for
+  /// arrays of the wrong size.
   void restore_preconditioner(const PreconditionerSource& source);
 
  private:
