@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "frostmpm/config/config_node.hpp"
 #include "frostmpm/grid/uniform_grid.hpp"
+#include "frostmpm/physics/boundary_type.hpp"
 #include "frostmpm/scene/region.hpp"
 #include "frostmpm/shape/stencil_cache.hpp"
 
@@ -204,4 +206,47 @@ TEST_CASE("faces of a periodic grid: the face across the periodic axis has one n
   for (double a : areas) length += a;
   REQUIRE(length == Approx(grid.cells[0] * grid.spacing[0]));
   REQUIRE(box_nodes<2>(grid, {0.0, 0.0}, {1.0, 0.0}).size() == std::size_t(grid.cells[0]));
+}
+
+TEST_CASE("a condition on a surface layer of particles holds the same nodes whatever the round-off and small "
+          "strains", "[shape][conditions]") {
+  // Four 0.1 m cells tall, two wide, 2×2 GIMP particles a cell. The layer is the top cell's two
+  // particle rows (all of the node row y = 0.4 and exactly half of y = 0.3, its lower edge) or its
+  // top particle row alone (three quarters of y = 0.4, an eighth of y = 0.3).
+  const double h = 0.1;
+  UniformGrid<2> grid;
+  grid.spacing = {h, h};
+  grid.cells = {2, 4};
+  grid.ghost_layers = ghost_layers(ShapeKind::Gimp);
+  const auto box = ConfigNode::load_string("box: {min: [0, 0], max: [0.2, 0.4]}");
+  const auto points = sample_region(grid, read_region_shape(box), 2);
+  auto held_rows = [&](double layer_bottom, double layer_strain, double shift) {
+    std::vector<double> pos, half, volume;
+    std::vector<std::size_t> layer;
+    for (std::size_t p = 0; p < points.size(); ++p) {
+      const bool in_layer = points[p][1] > layer_bottom;
+      // The layer a little strained and moved against the rest, as a load or a heave leaves it.
+      pos.insert(pos.end(), {points[p][0], points[p][1] + (in_layer ? shift : 0.0)});
+      half.insert(half.end(), {h / 4, h / 4});
+      volume.push_back(h * h / 4 * (in_layer ? 1.0 + layer_strain : 1.0));
+      if (in_layer) layer.push_back(p);
+    }
+    StencilCache<2> cache;
+    cache.configure(ShapeKind::Gimp);
+    REQUIRE(cache.update(grid, pos, half) == -1);
+    std::vector<double> node_volume(grid.node_count(), 0.0), share;
+    for (std::size_t p = 0; p < points.size(); ++p)
+      for (int k = 0; k < cache.per_particle(); ++k) node_volume[cache.nodes(p)[k]] += volume[p] * cache.weights(p)[k];
+    std::set<long> rows;  // node rows, counted in cells from y = 0
+    for (const std::size_t i : nodes_made_up_by(layer, cache, volume, node_volume, share))
+      rows.insert(std::lround(grid.node_position(i)[1] / h));
+    return std::vector<long>(rows.begin(), rows.end());
+  };
+  const std::vector<long> full_cell = {3, 4};
+  for (const double strain : {0.0, 1e-12, -1e-12, 1e-4, -1e-4, 0.02, -0.02})
+    for (const double shift : {0.0, 1e-6, -1e-6, 3e-4, -3e-4}) {
+      INFO("layer strain " << strain << ", shift " << shift << " m");
+      CHECK(held_rows(0.3, strain, shift) == full_cell);
+      CHECK(held_rows(0.35, strain, shift) == std::vector<long>{4});
+    }
 }
