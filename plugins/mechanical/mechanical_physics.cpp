@@ -118,6 +118,13 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
       .defaults_to(0.0)
       .at_least(0)
       .below(1);
+  s.real("minimum_node_mass", "-",
+         "a node lighter than this fraction of the heaviest node's mass (a particle domain grazing it) takes no "
+         "force and keeps the velocity its particles give it (Uintah's minimum mass for acceleration); raise it "
+         "where a heaving undrained surface draws a growing pore pressure (docs/verification.md, strip footing)")
+      .defaults_to(1e-4)
+      .at_least(0)
+      .below(0.1);
   s.choice("position_update", {"symplectic", "trapezoidal"},
            "symplectic: x += Δt v^k (the velocity the stress update used; second order); trapezoidal: "
            "x += Δt (v^k + ½ Δv), the paper's Algorithm 1 step 21 (first order with its stress update)")
@@ -145,6 +152,7 @@ MechanicalPhysics<Dim>::MechanicalPhysics(const ParamSet& p) : params_(p) {
   flip_ = p.real("flip_fraction");
   cfl_ = p.real("cfl");
   damping_ = p.real("local_damping");
+  minimum_node_mass_ = p.real("minimum_node_mass");
   jaumann_ = p.string("objective_rate") == "jaumann";
   trapezoidal_ = p.string("position_update") == "trapezoidal";
   geostatic_ = p.string("initial_stress") == "geostatic";
@@ -834,12 +842,14 @@ void MechanicalPhysics<Dim>::predict() {
   // A node that a particle's domain only grazes (the free end of a column crossing a node) has
   // a mass ∝ ε² of the overlap ε but a stress force ∝ ε: its acceleration ∝ 1/ε grows without
   // bound and the explicit step goes unstable at that node (seen at ε ~ 1e-4, mass ~ 1e-8 of a
-  // full node). Below kGrazingMass of the heaviest node it keeps the velocity the particles
+  // full node). Below minimum_node_mass of the heaviest node it keeps the velocity the particles
   // give it and takes no force (as Uintah's minimum mass for acceleration); the pressure
-  // cannot move it either (mobility 0 below).
+  // cannot move it either (mobility 0 below). With pore water a light node does harm long before
+  // its acceleration does: the kick it takes in a step counts in the pressure's volume balance,
+  // and the next P2G forgets it (docs/architecture.md, grazing nodes).
   double heaviest = 0;
   for (double m : mass_) heaviest = std::max(heaviest, m);
-  grazing_mass_ = kGrazingMass * heaviest;
+  grazing_mass_ = minimum_node_mass_ * heaviest;
   parallel_for(mass_.size(), [&](std::size_t i) {
     const double m = mass_[i];
     for (int d = 0; d < Dim; ++d)

@@ -124,7 +124,7 @@ class MechanicalPhysics final : public Physics {
   Kernel<Dim>* kernel_ = nullptr;
   double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
   /// Nodes lighter than this fraction of the heaviest node take no force (predict()).
-  static constexpr double kGrazingMass = 1e-6;
+  double minimum_node_mass_ = 1e-4;
   double grazing_mass_ = 0;
   bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
   bool cell_average_ = false;  ///< volumetric_strain: cell_average (average_volumetric_strain())
