@@ -33,9 +33,9 @@ ParamSpec& time_function_key(ParamSchema& keys, const std::string& name, const s
 ///
 /// "Half" has a margin, kHalfShareMargin: a layer whose lower edge lies on a node row (two
 /// particle rows filling the top cell) makes up exactly half of that row's nodes, and without the
-/// margin round-off and strains of 1e-4 decided, node by node, whether the row was held. A
-/// drained row that comes and goes along a surface let a 0.1 m strip footing's undrained frozen
-/// ground draw a suction that grew without bound on the free row beneath the held one.
+/// margin round-off and strains of 1e-4 decided, node by node, whether the row was held: a 0.1 m
+/// strip footing's drained surface came out drained on one node row in places and on two in
+/// others, and its undrained frozen ground drew a suction along the stretches of one.
 template <class Stencil>
 std::vector<std::size_t> nodes_made_up_by(const std::vector<std::size_t>& particles, const Stencil& stencil,
                                           std::span<const double> volume, const std::vector<double>& node_volume,
