@@ -123,8 +123,9 @@ class MechanicalPhysics final : public Physics {
   ParamSet params_;
   Kernel<Dim>* kernel_ = nullptr;
   double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
-  /// Nodes lighter than this fraction of the heaviest node take no force (predict()).
-  double minimum_node_mass_ = 1e-4;
+  /// Nodes lighter than this fraction of the heaviest node take no force (predict(); the scene's
+  /// minimum_node_mass, whose default the schema holds).
+  double minimum_node_mass_ = 0;
   double grazing_mass_ = 0;
   bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
   bool cell_average_ = false;  ///< volumetric_strain: cell_average (average_volumetric_strain())
