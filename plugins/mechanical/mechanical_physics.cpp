@@ -119,12 +119,13 @@ ParamSchema MechanicalPhysics<Dim>::schema() {
       .at_least(0)
       .below(1);
   s.real("minimum_node_mass", "-",
-         "a node lighter than this fraction of the heaviest node's mass (a particle domain grazing it) takes no "
-         "force and keeps the velocity its particles give it (Uintah's minimum mass for acceleration); raise it "
-         "where a heaving undrained surface draws a growing pore pressure (docs/verification.md, strip footing)")
-      .defaults_to(1e-4)
+         "a node's inertia in the skeleton's momentum balance and pressure correction is at least this fraction "
+         "of the mass of the heaviest material point whose domain reaches it: a node a particle only grazes "
+         "(a heaving or sliding surface) takes the bounded kick that reaches the particles, not one ∝ 1/overlap "
+         "(0: the lumped mass alone)")
+      .defaults_to(0.1)
       .at_least(0)
-      .below(0.1);
+      .at_most(1);
   s.choice("position_update", {"symplectic", "trapezoidal"},
            "symplectic: x += Δt v^k (the velocity the stress update used; second order); trapezoidal: "
            "x += Δt (v^k + ½ Δv), the paper's Algorithm 1 step 21 (first order with its stress update)")
@@ -263,7 +264,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   wave_modulus_.assign(n, 0.0);
   previous_T_.assign(n, 0.0);
   failed_.assign(n, 0);
-  for (auto* v : {&mass_, &drag_, &weight_}) v->assign(nodes, 0.0);
+  for (auto* v : {&mass_, &drag_, &weight_, &heaviest_particle_, &nodal_inertia_}) v->assign(nodes, 0.0);
   for (auto* v : {&force_, &momentum_, &start_velocity_, &mapped_velocity_}) v->assign(nodes * Dim, 0.0);
 }
 
@@ -451,8 +452,10 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   const auto inertia = inertia_.values();
   std::fill(mass_.begin(), mass_.end(), 0.0);
   std::fill(momentum_.begin(), momentum_.end(), 0.0);
+  std::fill(heaviest_particle_.begin(), heaviest_particle_.end(), 0.0);
   double* mass = mass_.data();
   double* momentum = momentum_.data();
+  double* heaviest = heaviest_particle_.data();
   for_support<Dim>(st.per_particle(), [&](auto K) {
     transfer.scatter([&](std::size_t p) {
       const auto* nodes = st.nodes(p);
@@ -468,6 +471,7 @@ void MechanicalPhysics<Dim>::map_to_grid() {
       }
       for (int k = 0; k < K; ++k) {
         mass[nodes[k]] += m_k[k];
+        if (w[k] > 0) heaviest[nodes[k]] = std::max(heaviest[nodes[k]], m);
         for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += p_k[k * Dim + d];
       }
     });
@@ -475,6 +479,7 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   auto& vn = node_velocity_.vector();
   parallel_for(mass_.size(), [&](std::size_t i) {
     for (int d = 0; d < Dim; ++d) vn[i * Dim + d] = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
+    nodal_inertia_[i] = std::max(mass_[i], minimum_node_mass_ * heaviest_particle_[i]);
   });
   tie_plates(vn, time_, 0.0, false);
   constrain(vn, time_, 0.0);
@@ -839,22 +844,17 @@ void MechanicalPhysics<Dim>::predict() {
   }
   const auto& vn = node_velocity_.vector();
   auto& v_star = node_predicted_.vector();
-  // A node that a particle's domain only grazes (the free end of a column crossing a node) has
-  // a mass ∝ ε² of the overlap ε but a stress force ∝ ε: its acceleration ∝ 1/ε grows without
-  // bound and the explicit step goes unstable at that node (seen at ε ~ 1e-4, mass ~ 1e-8 of a
-  // full node). Below minimum_node_mass of the heaviest node it keeps the velocity the particles
-  // give it and takes no force (as Uintah's minimum mass for acceleration); the pressure
-  // cannot move it either (mobility 0 below). With pore water a light node does harm long before
-  // its acceleration does: the kick it takes in a step counts in the pressure's volume balance,
-  // and the next P2G forgets it (docs/architecture.md, grazing nodes).
-  double heaviest = 0;
-  for (double m : mass_) heaviest = std::max(heaviest, m);
-  grazing_mass_ = minimum_node_mass_ * heaviest;
+  // A node that a particle's domain only grazes (a surface crossing a node row) has a mass ∝ ε²
+  // of the overlap ε but a force ∝ ε. With its lumped mass its kick ∝ 1/ε is unbounded: a dry
+  // step goes unstable there, and with pore water the kick counts in the pressure's volume
+  // balance while the next P2G hands the particles only ε of it — the pressure answers a volume
+  // change that never happens. Its inertia is therefore at least minimum_node_mass × the heaviest
+  // particle that reaches it (map_to_grid(); for one grazing particle its whole mass is what the
+  // G2P–P2G round trip gives the node's kick: docs/architecture.md, grazing nodes).
   parallel_for(mass_.size(), [&](std::size_t i) {
-    const double m = mass_[i];
+    const double m = nodal_inertia_[i];
     for (int d = 0; d < Dim; ++d)
-      v_star[i * Dim + d] = m > grazing_mass_ ? (m * vn[i * Dim + d] + dt_ * force_[i * Dim + d]) / (m + dt_ * drag_[i])
-                                              : vn[i * Dim + d];
+      v_star[i * Dim + d] = m > 0 ? (m * vn[i * Dim + d] + dt_ * force_[i * Dim + d]) / (m + dt_ * drag_[i]) : 0.0;
   });
   for (auto& c : velocity_bcs_) c.reaction = {};
   for (auto& c : friction_bcs_) c.reaction = {};
@@ -878,10 +878,10 @@ void MechanicalPhysics<Dim>::predict() {
   auto mobility = node_mobility_.mutable_values();
   auto group = node_group_.mutable_values();
   parallel_for(mass_.size(), [&](std::size_t i) {
-    const double m = mass_[i] + dt_ * drag_[i];
+    const double m = nodal_inertia_[i] + dt_ * drag_[i];
     group[i] = 0;
     for (int d = 0; d < Dim; ++d)
-      mobility[i * Dim + d] = mass_[i] > grazing_mass_ && constraint_owner_[i * Dim + d] == -1 ? 1.0 / m : 0.0;
+      mobility[i * Dim + d] = mass_[i] > 0 && constraint_owner_[i * Dim + d] == -1 ? 1.0 / m : 0.0;
   });
   for (std::size_t k = 0; k < plates_.size(); ++k) {
     const auto& c = plates_[k];
@@ -928,9 +928,9 @@ void MechanicalPhysics<Dim>::correct() {
         force_[nodes[b] * Dim + d] += vol[p] * (value * g[b * Dim + d] + liquid * w[b] * grad[d]);
   });
   parallel_for(mass_.size(), [&](std::size_t i) {
-    const double m = mass_[i] + dt_ * drag_[i];
+    const double m = nodal_inertia_[i] + dt_ * drag_[i];
     for (int d = 0; d < Dim; ++d)
-      v[i * Dim + d] = v_star[i * Dim + d] + (mass_[i] > grazing_mass_ ? dt_ * force_[i * Dim + d] / m : 0.0);
+      v[i * Dim + d] = v_star[i * Dim + d] + (mass_[i] > 0 ? dt_ * force_[i * Dim + d] / m : 0.0);
   });
   tie_plates(v, time_, 0.0, true);
   constrain(v, time_ + dt_, 1.0);

@@ -123,10 +123,9 @@ class MechanicalPhysics final : public Physics {
   ParamSet params_;
   Kernel<Dim>* kernel_ = nullptr;
   double flip_ = 1, cfl_ = 0.5, damping_ = 0, mass_scaling_ = 1;
-  /// Nodes lighter than this fraction of the heaviest node take no force (predict(); the scene's
-  /// minimum_node_mass, whose default the schema holds).
+  /// A node's inertia is at least this fraction of the heaviest particle reaching it (predict(); the
+  /// scene's minimum_node_mass, whose default the schema holds).
   double minimum_node_mass_ = 0;
-  double grazing_mass_ = 0;
   bool jaumann_ = true, geostatic_ = false, trapezoidal_ = false;
   bool cell_average_ = false;  ///< volumetric_strain: cell_average (average_volumetric_strain())
   std::vector<MaterialData> materials_;
@@ -157,6 +156,8 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> force_stress_;              ///< per particle: σ′ with its cell's mean trace, for the forces (predict())
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
+  std::vector<double> heaviest_particle_;  ///< the mass of the heaviest particle whose domain reaches the node
+  std::vector<double> nodal_inertia_;      ///< max(mass, minimum_node_mass × heaviest_particle_): predict(), correct()
   std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP
 
   // ---- step and counters
