@@ -847,10 +847,10 @@ void MechanicalPhysics<Dim>::predict() {
   // A node that a particle's domain only grazes (a surface crossing a node row) has a mass ∝ ε²
   // of the overlap ε but a force ∝ ε. With its lumped mass its kick ∝ 1/ε is unbounded: a dry
   // step goes unstable there, and with pore water the kick counts in the pressure's volume
-  // balance while the next P2G hands the particles only ε of it — the pressure answers a volume
-  // change that never happens. Its inertia is therefore at least minimum_node_mass × the heaviest
-  // particle that reaches it (map_to_grid(); for one grazing particle its whole mass is what the
-  // G2P–P2G round trip gives the node's kick: docs/architecture.md, grazing nodes).
+  // balance while the G2P–P2G round trip gives the node back only its weight S ∝ ε² of it — the
+  // pressure answers a volume change that never happens. Its inertia is therefore at least
+  // minimum_node_mass × the heaviest particle that reaches it (nodal_inertia_, map_to_grid();
+  // docs/architecture.md, grazing nodes).
   parallel_for(mass_.size(), [&](std::size_t i) {
     const double m = nodal_inertia_[i];
     for (int d = 0; d < Dim; ++d)
