@@ -264,7 +264,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   wave_modulus_.assign(n, 0.0);
   previous_T_.assign(n, 0.0);
   failed_.assign(n, 0);
-  for (auto* v : {&mass_, &drag_, &weight_, &heaviest_particle_, &nodal_inertia_}) v->assign(nodes, 0.0);
+  for (auto* v : {&mass_, &drag_, &weight_, &nodal_inertia_}) v->assign(nodes, 0.0);
   for (auto* v : {&force_, &momentum_, &start_velocity_, &mapped_velocity_}) v->assign(nodes * Dim, 0.0);
 }
 
@@ -452,10 +452,13 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   const auto inertia = inertia_.values();
   std::fill(mass_.begin(), mass_.end(), 0.0);
   std::fill(momentum_.begin(), momentum_.end(), 0.0);
-  std::fill(heaviest_particle_.begin(), heaviest_particle_.end(), 0.0);
+  // The floor under the inertia (predict()) scatters first: minimum_node_mass × the heaviest
+  // particle whose domain reaches the node; the node loop below raises it to the node's mass.
+  std::fill(nodal_inertia_.begin(), nodal_inertia_.end(), 0.0);
   double* mass = mass_.data();
   double* momentum = momentum_.data();
-  double* heaviest = heaviest_particle_.data();
+  double* inertia_floor = nodal_inertia_.data();
+  const double mu = minimum_node_mass_;
   for_support<Dim>(st.per_particle(), [&](auto K) {
     transfer.scatter([&](std::size_t p) {
       const auto* nodes = st.nodes(p);
@@ -471,7 +474,7 @@ void MechanicalPhysics<Dim>::map_to_grid() {
       }
       for (int k = 0; k < K; ++k) {
         mass[nodes[k]] += m_k[k];
-        if (w[k] > 0) heaviest[nodes[k]] = std::max(heaviest[nodes[k]], m);
+        if (w[k] > 0) inertia_floor[nodes[k]] = std::max(inertia_floor[nodes[k]], mu * m);
         for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += p_k[k * Dim + d];
       }
     });
@@ -479,7 +482,7 @@ void MechanicalPhysics<Dim>::map_to_grid() {
   auto& vn = node_velocity_.vector();
   parallel_for(mass_.size(), [&](std::size_t i) {
     for (int d = 0; d < Dim; ++d) vn[i * Dim + d] = mass_[i] > 0 ? momentum_[i * Dim + d] / mass_[i] : 0.0;
-    nodal_inertia_[i] = std::max(mass_[i], minimum_node_mass_ * heaviest_particle_[i]);
+    nodal_inertia_[i] = std::max(mass_[i], nodal_inertia_[i]);
   });
   tie_plates(vn, time_, 0.0, false);
   constrain(vn, time_, 0.0);

@@ -156,8 +156,8 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> force_stress_;              ///< per particle: σ′ with its cell's mean trace, for the forces (predict())
   // ---- per node
   std::vector<double> mass_, drag_, force_, momentum_, weight_, start_velocity_;  ///< start_velocity_: v^k after its conditions
-  std::vector<double> heaviest_particle_;  ///< the mass of the heaviest particle whose domain reaches the node
-  std::vector<double> nodal_inertia_;      ///< max(mass, minimum_node_mass × heaviest_particle_): predict(), correct()
+  /// max(mass, minimum_node_mass × the heaviest particle whose domain reaches the node): predict(), correct()
+  std::vector<double> nodal_inertia_;
   std::vector<double> mapped_velocity_;  ///< momentum / mass as mapped (before the conditions), for FLIP
 
   // ---- step and counters
