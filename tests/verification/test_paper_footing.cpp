@@ -13,8 +13,9 @@
 //   - with it on (the paper's Eq. 7), the meltwater's volume deficit draws the pore pressure of
 //     the thawing zone to −0.1 to −0.6 MPa, which raises the effective stress and the frictional
 //     strength (φ′ = 30°) above that of the undrained frozen ground (to d/B = 1 in the full
-//     run). docs/verification.md discusses why the paper's code measures the opposite (its
-//     resistance counts the pore pressure, and its ice cohesion never softens).
+//     run). docs/verification.md compares with the paper's code (both read the mixture's
+//     force and leave the ice's strength unsoftened; its tension cut-off is one falling value
+//     per material).
 #include <catch2/catch.hpp>
 
 #include <string>
