@@ -18,40 +18,51 @@
 
 using namespace frostmpm::test;
 
+namespace {
 
-TEST_CASE("smooth footing on a confined elastic column: the oedometric pressure, force = pressure x width, "
-          "displacement = the integral of its speed",
-          "[verification][mechanics][footing]") {
-  TempDir dir;
-  // H = 1 m, 0.1 m wide (rollers on both sides), E = 10 MPa, ν = 0.3: E_oed = 13.4615 MPa.
-  const std::string scene = dir.file("oedometer.yaml");
-  write_file(scene, R"yaml(task: simulation
+/// A confined column H = 1 m, 0.1 m wide (rollers on both sides), E = 10 MPa, ν = 0.3
+/// (E_oed = 13.4615 MPa), with a smooth footing on its top pushed at `speed` m/s (ramped over
+/// 0.05 s) to `end` s; `physics`, `material` and `probes` add lines to those sections.
+std::string oedometer_scene(const std::string& end, const std::string& speed, const std::string& physics,
+                            const std::string& material, const std::string& probes) {
+  return R"yaml(task: simulation
 grid: {cells: [2, 21], cell_size: 0.05}
-time: {end: 0.5}
+time: {end: )yaml" + end + R"yaml(}
 physics:
   mechanical: {local_damping: 0.1}
-materials:
+)yaml" + physics + R"yaml(materials:
   soil:
     porosity: 0.4
     solid_density: 2650
     water_density: 1000
     mechanical_model: {model: linear_elastic, youngs_modulus: 1.0e7, poisson_ratio: 0.3}
-regions:
+)yaml" + material + R"yaml(regions:
   - shape: {box: {min: [0, 0], max: [0.1, 1.0]}}
     material: soil
 boundary_conditions:
   - {type: fixed, nodes: {face: y_min}}
   - {type: roller, nodes: {face: x_min}}
   - {type: roller, nodes: {face: x_max}}
-  - {type: footing, name: plate, nodes: {box: {min: [0, 1.0], max: [0.1, 1.05]}}, y: {expression: "-0.01 * min(t / 0.05, 1)"}, contact: smooth}
+  - {type: footing, name: plate, nodes: {box: {min: [0, 1.0], max: [0.1, 1.05]}}, y: {expression: "-)yaml" + speed +
+         R"yaml( * min(t / 0.05, 1)"}, contact: smooth}
 output: {every: 0, metrics_every: 0.01}
 probes:
-  - {name: d, type: footing_displacement, boundary: plate}
-  - {name: F, type: footing_force, boundary: plate}
   - {name: q, type: footing_pressure, boundary: plate}
-  - {name: Ry, type: reaction, boundary: plate, component: y}
   - {name: s, type: settlement}
-)yaml");
+)yaml" + probes;
+}
+
+}  // namespace
+
+TEST_CASE("smooth footing on a confined elastic column: the oedometric pressure, force = pressure x width, "
+          "displacement = the integral of its speed",
+          "[verification][mechanics][footing]") {
+  TempDir dir;
+  const std::string scene = dir.file("oedometer.yaml");
+  write_file(scene, oedometer_scene("0.5", "0.01", "", "",
+                                    "  - {name: d, type: footing_displacement, boundary: plate}\n"
+                                    "  - {name: F, type: footing_force, boundary: plate}\n"
+                                    "  - {name: Ry, type: reaction, boundary: plate, component: y}\n"));
   const CsvTable t = run_scene(dir, scene, {}, "out");
   const double E_oed = 1e7 * 0.7 / (1.3 * 0.4);
   REQUIRE(E_oed == Approx(1.346154e7).epsilon(1e-6));
@@ -98,35 +109,11 @@ TEST_CASE("smooth footing on an undrained confined column: the footing carries t
   // answer is the same at any resolution up to the strain's size (2.5e-4), the top particles'
   // distance from the held row and the ramp's dynamics.
   const std::string scene = dir.file("undrained_oedometer.yaml");
-  write_file(scene, R"yaml(task: simulation
-grid: {cells: [2, 21], cell_size: 0.05}
-time: {end: 0.3}
-physics:
-  mechanical: {local_damping: 0.1}
-  hydraulic: {}
-materials:
-  soil:
-    porosity: 0.4
-    solid_density: 2650
-    water_density: 1000
-    water_compressibility: 5.0e-8
-    absolute_permeability: {model: constant, k0: 1.0e-12}
-    mechanical_model: {model: linear_elastic, youngs_modulus: 1.0e7, poisson_ratio: 0.3}
-regions:
-  - shape: {box: {min: [0, 0], max: [0.1, 1.0]}}
-    material: soil
-boundary_conditions:
-  - {type: fixed, nodes: {face: y_min}}
-  - {type: roller, nodes: {face: x_min}}
-  - {type: roller, nodes: {face: x_max}}
-  - {type: footing, name: plate, nodes: {box: {min: [0, 1.0], max: [0.1, 1.05]}}, y: {expression: "-0.001 * min(t / 0.05, 1)"}, contact: smooth}
-output: {every: 0, metrics_every: 0.01}
-probes:
-  - {name: q, type: footing_pressure, boundary: plate}
-  - {name: s, type: settlement}
-  - {name: p_mid, type: value_at, field: pore_pressure, point: [0.05, 0.5]}
-  - {name: syy_mid, type: value_at, field: stress.yy, point: [0.05, 0.5]}
-)yaml");
+  write_file(scene, oedometer_scene("0.3", "0.001", "  hydraulic: {}\n",
+                                    "    water_compressibility: 5.0e-8\n"
+                                    "    absolute_permeability: {model: constant, k0: 1.0e-12}\n",
+                                    "  - {name: p_mid, type: value_at, field: pore_pressure, point: [0.05, 0.5]}\n"
+                                    "  - {name: syy_mid, type: value_at, field: stress.yy, point: [0.05, 0.5]}\n"));
   const double E_oed = 1e7 * 0.7 / (1.3 * 0.4), water = 2e7 / 0.4;
   for (const double h : {0.05, 0.025}) {
     const int nx = int(std::lround(0.1 / h)), ny = int(std::lround(1.05 / h));
