@@ -6,6 +6,7 @@
     /usr/bin/python3 scripts/plot_verification.py prandtl OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py reissner OUT [OUT ...] [--png FILE]
     /usr/bin/python3 scripts/plot_verification.py granular OUT [OUT ...] [--png FILE]
+    /usr/bin/python3 scripts/plot_verification.py thawing_slope OUT [OUT ...] [--png FILE]
 
 terzaghi: configs/verification/terzaghi_consolidation.yaml runs (any cell sizes): the degree of
 consolidation U = settlement / (q H / E_oed) and the base pore pressure against Terzaghi's series
@@ -17,7 +18,11 @@ configs/verification/reissner_footing.yaml runs: the footing pressure over c N_c
 (φ = 20°) against the settlement in mm, with the window the test averages. granular:
 configs/verification/granular_collapse.yaml runs (any aspect ratio): one panel each, the final
 deposit's particles coloured by their plastic deviatoric strain over the column's outline, and
-the band of runouts the experiments give (Lube et al. 2005, ±20 %).
+the band of runouts the experiments give (Lube et al. 2005, ±20 %). thawing_slope:
+configs/verification/thawing_slope.yaml runs (any slope angle, set by gravity): the slide against
+time, labelled with McRoberts and Morgenstern's factor of safety for the run's angle, and the
+thawed layer's excess pore pressure over γ′ z cos β at the last frame against Morgenstern and
+Nixon's 1 / (1 + 1/(2R²)).
 Each OUT is a run folder; the legend shows its cell size from run.json.
 """
 import argparse
@@ -174,16 +179,46 @@ def granular(folders, png):
     plt.close(fig)
 
 
+def thawing_slope(folders, png, R=0.5, density=1750.0, buoyant=750.0, water=1000.0, top=0.3):
+    """Slide against time; the thawed layer's excess pore pressure ratio against depth."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for folder in folders:
+        scene = frostplot.run_summary(folder).get("resolved_scene", {})
+        gx, gy = scene["gravity"][:2]
+        beta = np.arctan2(gx, -gy)
+        phi = np.radians(scene["materials"]["soil"]["mechanical_model"]["friction_angle"])
+        fs = buoyant / density * np.sin(phi) / ((1 + 2 * R * R) * np.tan(beta))
+        label = f"FS = {fs:.2f} (β = {np.degrees(beta):.2f}°), {cell_label(folder)}"
+        m = metrics(folder)
+        line, = a.plot(m["time_s"] / 3600, 1e3 * m["slide"], "-", lw=1, label=label)
+        last = frostplot.read_fields.read_frames(folder)[-1]
+        depth = top - last["coordinates"][:, 1]
+        thawed = (last["fields"]["liquid_saturation"] > 0.5) & (depth > 0.005)
+        g_normal = np.hypot(gx, gy) * np.cos(beta)
+        excess = last["fields"]["pore_pressure"] - water * g_normal * depth
+        b.plot(excess[thawed] / (buoyant * g_normal * depth[thawed]), 100 * depth[thawed], ".", ms=3,
+               color=line.get_color(), label=label)
+    b.axvline(1 / (1 + 1 / (2 * R * R)), color="k", lw=0.8, label="Morgenstern & Nixon: 1 / (1 + 1/(2R²))")
+    a.set(xlabel="t [h]", ylabel="slide down the slope [mm]", title="the thawed layer's slide")
+    b.set(xlabel="excess pore pressure / (γ′ z cos β)", ylabel="depth z [cm]", xlim=(0, 0.6),
+          title="thawed layer at the last frame")
+    b.invert_yaxis()
+    a.legend(fontsize=7)
+    b.legend(fontsize=7)
+    frostplot.save(fig, png)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl", "reissner", "granular"])
+    parser.add_argument("figure", choices=["terzaghi", "mandel", "prandtl", "reissner", "granular",
+                                                  "thawing_slope"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png)")
     args = parser.parse_args()
     png = args.png or f"{args.figure}.png"
     {"terzaghi": terzaghi, "mandel": mandel, "prandtl": prandtl, "reissner": reissner,
-     "granular": granular}[args.figure](args.folders, png)
+     "granular": granular, "thawing_slope": thawing_slope}[args.figure](args.folders, png)
     print(f"wrote {png}")
 
 

@@ -63,9 +63,6 @@ ParamSchema HydraulicPhysics::material_schema() const {
 
 void HydraulicPhysics::setup(Kernel<kDim>& sim) {
   kernel_ = &sim;
-  // The pressure solve's lattice graph, cell pressures and upwinding do not wrap round yet.
-  if (sim.grid().any_periodic())
-    throw params_.section_error("the hydraulic physics does not run on a periodic grid (grid.periodic) yet");
   // The body force on the pore water is the scene's gravity; [0, 0] makes pressure the excess
   // (non-hydrostatic) pressure, as in the INTERFROST cases.
   gravity_ = sim.gravity();
@@ -355,7 +352,7 @@ void HydraulicPhysics::advect_grid_pressure() {
       const double u = v[i * kDim + d];
       if (u == 0) continue;
       auto neighbour = ijk;
-      neighbour[d] += u > 0 ? -1 : 1;  // upwind: where the material comes from
+      neighbour[d] = grid.wrap(d, neighbour[d] + (u > 0 ? -1 : 1));  // upwind: where the material comes from
       if (neighbour[d] < -grid.ghost_layers || neighbour[d] > grid.cells[d] + grid.ghost_layers) continue;
       const std::size_t j = grid.node_index(neighbour);
       if (was_active_[j] == 0) continue;

@@ -258,9 +258,12 @@ std::vector<std::vector<std::size_t>> HydraulicPhysics::group_rows() const {
     for (at[1] = ijk[1] - reach; at[1] <= ijk[1] + reach; ++at[1])
       for (at[0] = ijk[0] - reach; at[0] <= ijk[0] + reach; ++at[0]) {
         bool inside = true;
-        for (int d = 0; d < kDim; ++d)
-          inside = inside && at[d] >= -grid.ghost_layers && at[d] <= grid.cells[d] + grid.ghost_layers;
-        if (inside) rows[int(group[j])].insert(grid.node_index(at));
+        std::array<int, kDim> wrapped{};
+        for (int d = 0; d < kDim; ++d) {
+          wrapped[d] = grid.wrap(d, at[d]);
+          inside = inside && wrapped[d] >= -grid.ghost_layers && wrapped[d] <= grid.cells[d] + grid.ghost_layers;
+        }
+        if (inside) rows[int(group[j])].insert(grid.node_index(wrapped));
       }
   }
   for (auto& [_, r] : rows) out.emplace_back(r.begin(), r.end());
@@ -278,8 +281,8 @@ constexpr double kProjection[4][4] = {{7, -1, -5, -1}, {-1, 7, -1, -5}, {-5, -1,
 std::array<std::size_t, 4> cell_nodes(const UniformGrid<kDim>& grid, std::size_t c) {
   const int i = static_cast<int>(c % static_cast<std::size_t>(grid.cells[0]));
   const int j = static_cast<int>(c / static_cast<std::size_t>(grid.cells[0]));
-  return {grid.node_index({i, j}), grid.node_index({i + 1, j}), grid.node_index({i + 1, j + 1}),
-          grid.node_index({i, j + 1})};
+  const int right = grid.wrap(0, i + 1), top = grid.wrap(1, j + 1);  // a periodic grid's last cell closes on its first nodes
+  return {grid.node_index({i, j}), grid.node_index({right, j}), grid.node_index({right, top}), grid.node_index({i, top})};
 }
 }  // namespace
 

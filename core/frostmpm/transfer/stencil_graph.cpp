@@ -75,14 +75,26 @@ void StencilGraph::build_lattice(const UniformGrid<Dim>& grid, int radius,
   for (std::size_t i = 0; i < nodes; ++i) {
     row.clear();
     const auto ijk = grid.node_lattice(i);
+    // A periodic axis's last node row duplicates its first and no stencil reaches it: its row
+    // holds its diagonal alone.
+    bool seam = false;
+    for (int d = 0; d < Dim; ++d) seam = seam || (grid.periodic[d] && grid.wrap(d, ijk[d]) != ijk[d]);
+    if (seam) {
+      columns.push_back(static_cast<int>(i));
+      offsets[i + 1] = columns.size();
+      continue;
+    }
     std::array<int, Dim> lo{}, hi{}, at{};
     for (int d = 0; d < Dim; ++d) {
-      lo[d] = std::max(ijk[d] - radius, -grid.ghost_layers);
-      hi[d] = std::min(ijk[d] + radius, grid.cells[d] + grid.ghost_layers);
+      // Along a periodic axis the neighbourhood wraps round the seam (the stencils do too).
+      lo[d] = grid.periodic[d] ? ijk[d] - radius : std::max(ijk[d] - radius, -grid.ghost_layers);
+      hi[d] = grid.periodic[d] ? ijk[d] + radius : std::min(ijk[d] + radius, grid.cells[d] + grid.ghost_layers);
     }
     at = lo;
     while (true) {
-      row.push_back(static_cast<int>(grid.node_index(at)));
+      std::array<int, Dim> wrapped{};
+      for (int d = 0; d < Dim; ++d) wrapped[d] = grid.wrap(d, at[d]);
+      row.push_back(static_cast<int>(grid.node_index(wrapped)));
       int d = 0;
       while (d < Dim && ++at[d] > hi[d]) {
         at[d] = lo[d];
