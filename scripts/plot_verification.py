@@ -179,14 +179,20 @@ def granular(folders, png):
     plt.close(fig)
 
 
-def thawing_slope(folders, png, R=0.5, density=1750.0, buoyant=750.0, water=1000.0, top=0.3):
-    """Slide against time; the thawed layer's excess pore pressure ratio against depth."""
+def thawing_slope(folders, png, R=0.5):
+    """Slide against time; the thawed layer's excess pore pressure ratio against depth. The unit
+    weights, the slope and φ′ come from each run's resolved scene; R is the scene's 0.5."""
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
     for folder in folders:
         scene = frostplot.run_summary(folder).get("resolved_scene", {})
+        soil = scene["materials"]["soil"]
+        n, water = soil["porosity"], soil["water_density"]
+        density = (1 - n) * soil["solid_density"] + n * water  # saturated
+        buoyant = density - water
+        top = scene["regions"][0]["shape"]["box"]["max"][1]
         gx, gy = scene["gravity"][:2]
         beta = np.arctan2(gx, -gy)
-        phi = np.radians(scene["materials"]["soil"]["mechanical_model"]["friction_angle"])
+        phi = np.radians(soil["mechanical_model"]["friction_angle"])
         fs = buoyant / density * np.sin(phi) / ((1 + 2 * R * R) * np.tan(beta))
         label = f"FS = {fs:.2f} (β = {np.degrees(beta):.2f}°), {cell_label(folder)}"
         m = metrics(folder)

@@ -164,8 +164,9 @@ TEST_CASE("a thawing infinite slope (McRoberts & Morgenstern 1974): the thawed l
   // FS = (γ′/γ) sin φ′ / ((1 + 2R²) tan β) = 1 / (7 tan β); u / (γ′ z cos β) = 1 / (1 + 1/(2R²)) = 1/3.
   constexpr double kG = 9.81, kR = 0.5, kRatio = 1.0 / (1.0 + 1.0 / (2 * kR * kR));
   TempDir dir;
+  const auto slope_angle = [](double fs) { return std::atan(1.0 / (7.0 * fs)); };  // β of a factor of safety
   auto run = [&](double fs, double h) {
-    const double beta = std::atan(1.0 / (7.0 * fs));
+    const double beta = slope_angle(fs);
     const std::string name = "fs" + std::to_string(int(std::lround(100 * fs))) + "_h" + std::to_string(int(std::lround(1000 * h)));
     return run_scene(dir, verification_scene("thawing_slope.yaml"),
                      {"grid.cells=[4, " + std::to_string(int(std::lround(0.3 / h))) + "]", "grid.cell_size=" + exact_number(h),
@@ -188,7 +189,7 @@ TEST_CASE("a thawing infinite slope (McRoberts & Morgenstern 1974): the thawed l
   };
   // The excess pore pressure over γ′ z cos β at depth z (the probes p_depth_3cm and p_depth_6cm).
   auto excess_ratio = [&](const CsvTable& t, double fs, const char* probe, double z) {
-    const double g_normal = kG * std::cos(std::atan(1.0 / (7.0 * fs)));
+    const double g_normal = kG * std::cos(slope_angle(fs));
     const double p = t.rows.back()[t.column(probe)];
     return (p - 1000 * g_normal * z) / (750 * g_normal * z);
   };
