@@ -14,8 +14,8 @@
 //     the thawing zone to −0.1 to −0.6 MPa, which raises the effective stress and the frictional
 //     strength (φ′ = 30°) above that of the undrained frozen ground (to d/B = 1 in the full
 //     run). docs/verification.md compares with the paper's code (both read the mixture's
-//     force and leave the ice's strength unsoftened; its tension cut-off is one falling value
-//     per material).
+//     force and leave the ice's strength unsoftened; its tension cut-off, one falling value
+//     per material, was tried and raises the thawing ground further).
 #include <catch2/catch.hpp>
 
 #include <string>
