@@ -1,7 +1,8 @@
 // Particles that leave the grid: by default the run stops with one line naming the particle, its
 // region and the time (exit 3); with `grid.particles_leaving: remove` they are dropped and what
 // they carried is counted in run.json (heat, mass), the balances stay closed, and a run stopped
-// with SIGTERM after some left continues with `--restart` to the metrics of an uninterrupted run.
+// with SIGTERM after some left continues with `--restart` to the metrics of an uninterrupted run,
+// and so does a checkpoint taken between the step that moved particles off and their removal.
 #include <catch2/catch.hpp>
 
 #include <chrono>
@@ -89,6 +90,24 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
       CHECK(row[metrics.column("T_min")] == Approx(5.0).epsilon(1e-9));
       CHECK(row[metrics.column("T_max")] == Approx(5.0).epsilon(1e-9));
     }
+  }
+
+  SECTION("a restart whose checkpoint holds particles the last step moved off the grid counts them") {
+    // Column k = 28's domain passes x = 1 at t = 0.88 s: the run ending 5 µs later checkpoints
+    // after the step that moved it off, before the next step would remove it.
+    const std::string out = dir.file("edge");
+    const auto first = run_frostmpm("run " + dir.file("block.yaml") + " -o " + out + " --set time.end=0.880005");
+    REQUIRE(first.exit_code == 0);
+    const auto removed_before = std::stoi(run_json(out, "['run']['removed_particles']"));
+    CHECK(removed_before >= 20);
+    CHECK(removed_before < 40);
+    const auto resumed = run_frostmpm("run --restart " + out + " --set time.end=1.606");
+    INFO(resumed.output);
+    REQUIRE(resumed.exit_code == 0);
+    CHECK(run_json(out, "['run']['removed_particles']") == "400");
+    CHECK(run_counter(out, "mechanical.mass_removed_kg") == Approx(400 * 1e-4 * 1700).epsilon(1e-9));
+    const double removed = run_counter(out, "thermal.energy_removed_J");
+    CHECK(-run_counter(out, "thermal.energy_stored_change_J") == Approx(removed).epsilon(1e-8));
   }
 
   SECTION("a run stopped after particles left continues with --restart to the same metrics") {

@@ -769,8 +769,12 @@ LoopState Simulation::restore_checkpoint(const std::string& dir) {
     checkpoint.read_physics(kCarriedNodeFields, carried);
   if (const auto extremes = probes_.persistent_state(); !extremes.empty())
     checkpoint.read_physics(kProbeState, extremes);
-  if (removed) {  // stencils for the particles that remain, before the physics rebuild their state
-    update_stencil();
+  if (removed) {
+    // Stencils for the particles that remain, before the physics rebuild their state. Particles
+    // the last step moved off the grid stay: the first step removes them and counts what they
+    // carry, as the uninterrupted run did (removing them here would count it before the
+    // physics' counters are restored, and lose it).
+    transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
     positions_changed_ = moving_;
   }
   LoopState loop = checkpoint.loop();
