@@ -11,6 +11,7 @@
     /usr/bin/python3 scripts/plot_paper.py footing_thermal OUT_0.2 OUT_0.1 [OUT_0.05] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py footing OUT_unthawed OUT_thawing OUT_prethawed [...] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py slump OUT [--png FILE] [--frame N]
+    /usr/bin/python3 scripts/plot_paper.py planar_slump OUT [OUT ...] [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py footing_rates OUT_2 OUT_1 OUT_0.5 OUT_0.25 [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
@@ -36,7 +37,10 @@ Prandtl–Reissner pressure of the thawed soil (Fig. 27), and each run's plastic
 at its last frame with the −1 and 0 °C lines (Figs. 25–26). slump: the thaw slump of Sec. 5.3.1
 (configs/paper/thaw_slump.yaml) at one frame (the last unless --frame): temperature, plastic
 deviatoric strain and displacement, each with the thaw front (S_l = ½) and the slope's initial
-surface (Figs. 20–22), and the thaw depths and displacements against time. footing_rates: the
+surface (Figs. 20–22), and the thaw depths and displacements against time. planar_slump: the
+planar slope after Harris et al. (2001) (configs/paper/thaw_slump_planar.yaml), one row per run:
+plastic deviatoric strain and u_x at one frame, and the thaw depth and movement against time with
+the depth at which the infinite-slope factor of safety is 1. footing_rates: the
 strip footing pushed at different speeds (Sec. 5.3.2, Fig. 28): for each run the plastic deviatoric
 strain at d/B = 0.5, 1 and 1.5 with the 0 and −1 °C lines, and the footing pressures against d/B.
 Each OUT is a run folder (metrics.csv, fields.h5).
@@ -410,6 +414,17 @@ def slump_neumann_estimate():
     return lambda days: front(86400.0 * np.asarray(days))
 
 
+def slump_frame_panel(ax, fig, fr, title, values, levels, cmap, label, surface):
+    """One field of a slump frame with the thaw front (S_l = ½, dashed) and the initial surface."""
+    frostplot.scalar_panel(ax, fig, fr, np.asarray(values), label, levels=levels, cmap=cmap)
+    tri = frostplot.triangulation(fr["coordinates"][:, :2])
+    ax.tricontour(tri, fr["fields"]["liquid_saturation"], levels=[0.5], colors="w" if cmap == "viridis" else "k",
+                  linewidths=1.2, linestyles="--")
+    surface = np.array(surface)
+    ax.plot(surface[:, 0], surface[:, 1], color="0.4", lw=0.8, ls=":")
+    ax.set(title=f"{title}, t = {fr['time']:.1f} s ({fr['time']:.1f} days of thaw)")
+
+
 def slump(folder, png, frame):
     """Temperature, plastic deviatoric strain and displacement of one frame (Figs. 20–22) with the
     thaw front and the initial surface, and the probes against time."""
@@ -422,14 +437,9 @@ def slump(folder, png, frame):
                "plastic deviatoric strain"),
               ("displacement", np.hypot(u[:, 0], u[:, 1]), None, "viridis", "|u| [m]")]
     fig, axes = plt.subplots(2, 2, figsize=(13, 7.5))
-    surface = np.array(SLUMP_SURFACE)
     for ax, (title, values, levels, cmap, label) in zip(axes.flat, panels):
-        frostplot.scalar_panel(ax, fig, fr, np.asarray(values), label, levels=levels, cmap=cmap)
-        tri = frostplot.triangulation(fr["coordinates"][:, :2])
-        ax.tricontour(tri, f["liquid_saturation"], levels=[0.5], colors="w" if cmap == "viridis" else "k",
-                      linewidths=1.2, linestyles="--")
-        ax.plot(surface[:, 0], surface[:, 1], color="0.4", lw=0.8, ls=":")
-        ax.set(xlim=(0, 1.4), ylim=(0, 0.5), title=f"{title}, t = {fr['time']:.1f} s ({fr['time']:.1f} days of thaw)")
+        slump_frame_panel(ax, fig, fr, title, values, levels, cmap, label, SLUMP_SURFACE)
+        ax.set(xlim=(0, 1.4), ylim=(0, 0.5))
     if "displacement" in f:
         step = max(1, len(x) // 400)
         axes.flat[2].quiver(x[::step], y[::step], u[::step, 0], u[::step, 1], angles="xy", scale_units="xy", scale=1,
@@ -448,6 +458,41 @@ def slump(folder, png, frame):
     lines = a.get_legend_handles_labels()
     more = b.get_legend_handles_labels()
     a.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="upper left")
+    frostplot.save(fig, png)
+
+
+PLANAR_SURFACE = [(0, 0.175), (1.4, 0.175), (1.4, 0)]  # thaw_slump_planar.yaml, in the slope's frame
+PLANAR_ONSET_DEPTH = 0.0259 / (1 - 0.382)  # its header: the thaw depth where FS(X) = 1
+
+
+def planar_slump(folders, png, frame):
+    """The planar thaw slump (configs/paper/thaw_slump_planar.yaml), one row per run: plastic
+    deviatoric strain and displacement at one frame, in the slope's frame, with the thaw front and
+    the initial surface; below, thaw depth and movement against time with the thaw depth at which
+    the infinite-slope factor of safety falls to 1."""
+    fig, axes = plt.subplots(len(folders) + 1, 2, figsize=(15, 2.6 * len(folders) + 3.4), squeeze=False)
+    for row, folder in zip(axes[:-1], folders):
+        name = os.path.basename(folder.rstrip("/"))
+        fr = frostplot.read_fields.read_frames(folder)[frame]
+        u = np.asarray(fr["fields"]["displacement"])
+        slump_frame_panel(row[0], fig, fr, f"{name}: plastic deviatoric strain", fr["fields"]["plastic_deviatoric_strain"],
+                          np.linspace(0, 2, 11), "viridis", "plastic deviatoric strain", PLANAR_SURFACE)
+        slump_frame_panel(row[1], fig, fr, f"{name}: u_x (downslope)", u[:, 0], None, "viridis", "u_x [m]",
+                          PLANAR_SURFACE)
+        for ax in row:
+            ax.set(xlim=(0, 3.5), ylim=(0, 0.28))
+    a, b = axes[-1]
+    for i, folder in enumerate(folders):
+        name = os.path.basename(folder.rstrip("/"))
+        m = metrics(folder)
+        a.plot(m["time_s"], m["thaw_depth_middle"], f"C{i}", label=f"{name}: thaw depth at x = 0.7 m")
+        b.plot(m["time_s"], m["surface_middle_x"], f"C{i}", label=f"{name}: surface point from x = 0.7 m")
+        b.plot(m["time_s"], m["toe_x"], f"C{i}--", label=f"{name}: top corner of the free end")
+    a.axhline(PLANAR_ONSET_DEPTH, color="k", ls=":", label="FS = 1 (infinite slope, drained)")
+    a.set(xlabel="t [s] = days of thaw", ylabel="depth [m]", title="thaw depth (S_l = ½)")
+    b.set(xlabel="t [s] = days of thaw", ylabel="u_x [m]", title="downslope movement")
+    a.legend(fontsize=7)
+    b.legend(fontsize=7)
     frostplot.save(fig, png)
 
 
@@ -489,7 +534,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
-                                                      "footing_thermal", "footing", "slump", "footing_rates"])
+                                                      "footing_thermal", "footing", "slump", "planar_slump",
+                                                      "footing_rates"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -513,6 +559,8 @@ def main():
         footing(args.folders, png)
     elif args.figure == "slump":
         slump(args.folders[0], png, args.frame)
+    elif args.figure == "planar_slump":
+        planar_slump(args.folders, png, args.frame)
     elif args.figure == "footing_rates":
         footing_rates(args.folders, png)
     else:

@@ -1,7 +1,8 @@
 // The infinite slope (configs/verification/infinite_slope.yaml) on a grid periodic down the slope:
 // the strength-reduction factor at which the layer fails against the limit-equilibrium factor of
 // safety FS = c/(γ d sinβ) + tanφ/tanβ, at three resolutions; and a sliding layer whose particles
-// cross the periodic seam, the same on a narrow and a wide grid and on 1 and 2 threads.
+// cross the periodic seam, the same on a narrow and a wide grid and on 1 and 2 threads; thawing
+// slopes: the infinite one of McRoberts & Morgenstern, and the paper's planar slope at 10 g.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -214,4 +215,32 @@ TEST_CASE("a thawing infinite slope (McRoberts & Morgenstern 1974): the thawed l
   CHECK(error_3cm[0] < 0.15);
   CHECK(error_3cm[1] < 0.10);
   CHECK(std::log(error_3cm[0] / error_3cm[1]) / std::log(0.01 / 0.0075) > 0.7);
+}
+
+TEST_CASE("a thawing planar slope at 10 g (Harris et al. 2001, 24°): frozen it stands, and the thawed layer "
+          "slides once the infinite-slope factor of safety has fallen below 1",
+          "[verification][mechanics][hydraulic][thermal][slope][paper]") {
+  // configs/paper/thaw_slump_planar.yaml without the melting source's suction: a 0.175 m layer of
+  // the thaw slump's silt (c′ = 2 kPa, φ′ = 20°, ψ = 0) on a 24° base at 10 g. Thawed and drained,
+  // FS(X) = (γ′/γ) sin φ′ / tan β + c′ cos φ′ / (γ X sin β cos β) is 1 at X = 0.042 m and 0.53
+  // at X = 0.175 m; frozen, the ice's 200 kPa of cohesion holds it.
+  const double rho = 0.6 * 2650 + 0.4 * 1000, gamma = rho * 98.1, beta = 24 * M_PI / 180, phi = 20 * M_PI / 180;
+  const double frictional = (rho - 1000) / rho * std::sin(phi) / std::tan(beta);
+  const double onset_depth = 2000 * std::cos(phi) / (gamma * std::sin(beta) * std::cos(beta)) / (1 - frictional);
+  REQUIRE(onset_depth == Approx(0.0419).epsilon(2e-3));
+  TempDir dir;
+  const std::string scene = verification_scene("../paper/thaw_slump_planar.yaml");
+  const CsvTable frozen = run_scene(dir, scene, {"boundary_conditions.2.value=-10", "time.end=1", "output.every=0"}, "frozen");
+  const CsvTable thawing = run_scene(dir, scene, {"physics.hydraulic.phase_change_source=false", "time.end=2.5",
+                                                  "output.every=0"}, "thawing");
+  const auto moved = [](const CsvTable& t) { return t.rows.back()[t.column("surface_middle_x")]; };
+  // Measured: frozen 1.8e-5 m after a day; thawing 0.33 m after 2.5 days, the layer thawed through at 2.
+  WARN("planar slope: surface at x = 0.7 m moved " << moved(frozen) << " m in a day frozen, " << moved(thawing)
+                                                   << " m in 2.5 days thawing");
+  CHECK(std::abs(moved(frozen)) < 1e-3);
+  CHECK(moved(thawing) > 0.1);
+  // Nothing slides before the thawed layer is deep enough to fail.
+  const auto depth = thawing.column("thaw_depth_middle"), slide = thawing.column("surface_middle_x");
+  for (const auto& row : thawing.rows)
+    if (row[depth] < onset_depth) CHECK(std::abs(row[slide]) < 1e-3);
 }
