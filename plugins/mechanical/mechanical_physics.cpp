@@ -11,6 +11,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "frostmpm/io/log.hpp"
 #include "frostmpm/models/pore_space.hpp"
 #include "frostmpm/models/tensor3.hpp"
 #include "frostmpm/parallel/parallel.hpp"
@@ -246,6 +247,7 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
     variables_.push_back(FieldHandle::particle(name));
     variables_start_.push_back(FieldHandle::particle(ParticleStore::history_name(name)));
   }
+  warn_of_locking(kernel);
   if (geostatic_) {
     const auto g = kernel.gravity();
     if (!(g[Dim - 1] < 0))
@@ -266,6 +268,23 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   failed_.assign(n, 0);
   for (auto* v : {&mass_, &drag_, &weight_, &nodal_inertia_}) v->assign(nodes, 0.0);
   for (auto* v : {&force_, &momentum_, &start_velocity_, &mapped_velocity_}) v->assign(nodes * Dim, 0.0);
+}
+
+/// Plastic flow at ψ = 0 keeps the volume, and linear/GIMP cells cannot follow it particle by
+/// particle: the default (each particle's own volumetric strain) then over-predicts strength by
+/// tens of per cent, or holds a slope that should flow. A scene that chose it keeps it silently.
+template <int Dim>
+void MechanicalPhysics<Dim>::warn_of_locking(const Kernel<Dim>& kernel) const {
+  if (cell_average_ || params_.given("volumetric_strain")) return;
+  for (std::size_t i = 0; i < materials_.size(); ++i) {
+    if (!materials_[i].model->yield_function({}, {}, {})) continue;  // no yield surface: elastic
+    log::warning(params_.where("volumetric_strain").describe() + ": material '" + kernel.materials()[i].name +
+                 "' is plastic ('" + materials_[i].model_name +
+                 "'), and each particle's own volumetric strain (volumetric_strain: particle, the default) locks "
+                 "plastic flow that keeps its volume: footings read too strong, slopes creep that should flow "
+                 "(user guide, volumetric locking); set volumetric_strain: cell_average, or particle to keep it");
+    return;
+  }
 }
 
 template <int Dim>

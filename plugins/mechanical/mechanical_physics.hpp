@@ -112,6 +112,7 @@ class MechanicalPhysics final : public Physics {
     double contact_area = 0;  ///< the box across the axis, within the grid [m² (m in 2-D)]
     double displacement = 0;  ///< along `axis` since t = 0, signed [m]
   };
+  void warn_of_locking(const Kernel<Dim>& kernel) const;
   struct MaterialData {
     std::shared_ptr<MechanicalModel> model;
     std::string model_name;

@@ -3,7 +3,8 @@
 // φ = 20° cannot hold the elastic K0 = ν/(1 − ν) = 0.4286 below Rankine's active ratio
 // K_a = (1 − sin φ)/(1 + sin φ) = 0.4903, so every particle's σ_xx/σ_yy ends at or above K_a
 // (elastic: 0.4286, below it), with its plastic strain, yielded flag and strength in fields.h5.
-// mohr_coulomb_ice reads λ from the material's freezing curve.
+// mohr_coulomb_ice reads λ from the material's freezing curve; a plastic material left at the
+// default volumetric strain is warned of locking.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -94,4 +95,24 @@ TEST_CASE("mohr_coulomb_ice reads lambda from the material's freezing curve", "[
   const auto clash = run_frostmpm("check " + source_dir() + "/configs/paper/rock_freezing.yaml" + model + ", lambda: 0.4}'");
   CHECK(clash.exit_code == 2);
   CHECK(clash.output.find("materials.rock.sfcc.lambda") != std::string::npos);
+}
+
+TEST_CASE("a plastic material left at each particle's own volumetric strain is warned of locking, a chosen "
+          "volumetric_strain, or an elastic material, is not",
+          "[mohr_coulomb]") {
+  const std::string plastic = " --set 'materials.soil.mechanical_model={model: mohr_coulomb, youngs_modulus: 1.0e6, "
+                              "poisson_ratio: 0.3, cohesion: 0, friction_angle: 20}'";
+  const auto warned = run_frostmpm("check " + kColumn + plastic);
+  INFO(warned.output);
+  REQUIRE(warned.exit_code == 0);
+  CHECK(warned.output.find("warning: ") != std::string::npos);
+  CHECK(warned.output.find("at 'physics.mechanical': material 'soil' is plastic ('mohr_coulomb')") != std::string::npos);
+  CHECK(warned.output.find("set volumetric_strain: cell_average") != std::string::npos);
+  for (const std::string quiet : {plastic + " --set physics.mechanical.volumetric_strain=particle",
+                                  plastic + " --set physics.mechanical.volumetric_strain=cell_average", std::string()}) {
+    const auto r = run_frostmpm("check " + kColumn + quiet);
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.output.find("locks") == std::string::npos);
+  }
 }

@@ -190,6 +190,12 @@ void ParamSet::set(const std::string& name, ParamValue value, SourceLocation whe
   if (!values_.count(name)) order_.push_back(name);
   values_[name] = std::move(value);
   where_[name] = std::move(where);
+  defaulted_.erase(name);
+}
+
+void ParamSet::set_default(const std::string& name, ParamValue value, SourceLocation where) {
+  set(name, std::move(value), std::move(where));
+  defaulted_.insert(name);
 }
 
 YAML::Node ParamSet::to_yaml() const {
@@ -257,7 +263,7 @@ ParamSet parse_params(const ParamSchema& schema, const ConfigNode& node,
       const ConfigNode value = node.child(spec.name);
       set.set(spec.name, read_value(spec, value), value.where());
     } else if (spec.default_value) {
-      set.set(spec.name, *spec.default_value, node.where());
+      set.set_default(spec.name, *spec.default_value, node.where());
     } else if (!spec.required()) {
       continue;  // optional: absent
     } else {

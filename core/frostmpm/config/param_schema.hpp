@@ -3,6 +3,7 @@
 // allowed range, unit and a one-line doc. The same schema drives validation of the scene,
 // `frostmpm describe` and the generated config reference.
 #include <map>
+#include <set>
 #include <optional>
 #include <string>
 #include <variant>
@@ -95,6 +96,8 @@ class ParamSet {
   const std::string& string(const std::string& name) const;
   const std::vector<double>& reals(const std::string& name) const;
   bool has(const std::string& name) const { return values_.count(name) != 0; }
+  /// True when the scene gave the value (false: the schema's default filled it in).
+  bool given(const std::string& name) const { return values_.count(name) != 0 && !defaulted_.count(name); }
 
   SourceLocation where(const std::string& name) const;
   /// Error about one parameter (cross-parameter checks in a model's constructor use this).
@@ -109,11 +112,14 @@ class ParamSet {
   YAML::Node to_yaml() const;
 
   void set(const std::string& name, ParamValue value, SourceLocation where);
+  /// The schema's default, at the section's location.
+  void set_default(const std::string& name, ParamValue value, SourceLocation where);
 
  private:
   std::vector<std::string> order_;
   std::map<std::string, ParamValue> values_;
   std::map<std::string, SourceLocation> where_;
+  std::set<std::string> defaulted_;
   SourceLocation section_;
   const ParamValue& get(const std::string& name) const;
 };
