@@ -3,8 +3,8 @@
 // allowed range, unit and a one-line doc. The same schema drives validation of the scene,
 // `frostmpm describe` and the generated config reference.
 #include <map>
-#include <set>
 #include <optional>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>

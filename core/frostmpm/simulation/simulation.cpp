@@ -540,7 +540,7 @@ void Simulation::apply_initial_values() {
 
 // ---- geometry and the step ------------------------------------------------------------------------
 
-void Simulation::update_stencil() {
+long Simulation::locate_particles() {
   if (grid_.any_periodic()) {
     // A particle that crossed a periodic seam re-enters at the other side.
     auto x = particles_.field("position");
@@ -548,7 +548,11 @@ void Simulation::update_stencil() {
       for (int d = 0; d < kDim; ++d) x[p * kDim + d] = grid_.wrap_position(d, x[p * kDim + d]);
     });
   }
-  long outside = transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+  return transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+}
+
+void Simulation::update_stencil() {
+  long outside = locate_particles();
   if (outside >= 0 && leaving_ == LeavingPolicy::Remove) {
     // The stencil of a particle outside the grid has every weight zero (inside: they sum to 1).
     const auto& st = transfer_.stencil();
@@ -774,7 +778,7 @@ LoopState Simulation::restore_checkpoint(const std::string& dir) {
     // the last step moved off the grid stay: the first step removes them and counts what they
     // carry, as the uninterrupted run did (removing them here would count it before the
     // physics' counters are restored, and lose it).
-    transfer_.update(grid_, particles_.field("position"), particles_.field("half_size"));
+    locate_particles();
     positions_changed_ = moving_;
   }
   LoopState loop = checkpoint.loop();

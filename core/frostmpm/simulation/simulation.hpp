@@ -159,6 +159,11 @@ class Simulation final : public Kernel<kDim> {
                        Set&& set);
   /// Positions moved: GIMP domains and volumes from the deformation gradient, stencils.
   void update_geometry();
+  /// Periodic positions wrapped and the stencils rebuilt; returns the first particle outside the
+  /// grid, or −1.
+  long locate_particles();
+  /// locate_particles, then particles off the grid removed (grid.particles_leaving: remove) or
+  /// the run stopped.
   void update_stencil();
   /// Drops the particles flagged in `leaving` from the particle fields, the transfer's materials,
   /// the boundary conditions' and probes' particle lists and every physics (which counts what
