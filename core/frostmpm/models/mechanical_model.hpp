@@ -67,7 +67,8 @@ class MechanicalModel {
   virtual void integrate(const StressUpdateInput& in, const StressUpdateOutput& out) const = 0;
   /// A plasticity model's yield function F(σ′, internal variables) for n points [Pa], ≤ 0 where
   /// the stress is admissible: `frostmpm test-model` checks that every returned stress lies on or
-  /// inside the surface its internal variables describe. false: the model has no yield surface.
+  /// inside the surface its internal variables describe, and a scene using a model with one is
+  /// warned of volumetric locking (called with empty spans for that). false: no yield surface.
   virtual bool yield_function(std::span<const double> /*stress*/, std::span<const double> /*state*/,
                               std::span<double> /*value*/) const {
     return false;
