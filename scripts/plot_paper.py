@@ -417,9 +417,10 @@ def slump_neumann_estimate():
 def slump_frame_panel(ax, fig, fr, title, values, levels, cmap, label, surface):
     """One field of a slump frame with the thaw front (S_l = ½, dashed) and the initial surface."""
     frostplot.scalar_panel(ax, fig, fr, np.asarray(values), label, levels=levels, cmap=cmap)
-    tri = frostplot.triangulation(fr["coordinates"][:, :2])
-    ax.tricontour(tri, fr["fields"]["liquid_saturation"], levels=[0.5], colors="w" if cmap == "viridis" else "k",
-                  linewidths=1.2, linestyles="--")
+    saturation = np.asarray(fr["fields"]["liquid_saturation"])
+    if saturation.min() < 0.5 < saturation.max():  # a front to draw (none once thawed through)
+        ax.tricontour(frostplot.triangulation(fr["coordinates"][:, :2]), saturation, levels=[0.5],
+                      colors="w" if cmap == "viridis" else "k", linewidths=1.2, linestyles="--")
     surface = np.array(surface)
     ax.plot(surface[:, 0], surface[:, 1], color="0.4", lw=0.8, ls=":")
     ax.set(title=f"{title}, t = {fr['time']:.1f} s ({fr['time']:.1f} days of thaw)")
