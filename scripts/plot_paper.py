@@ -462,8 +462,23 @@ def slump(folder, png, frame):
     frostplot.save(fig, png)
 
 
-PLANAR_SURFACE = [(0, 0.175), (1.4, 0.175), (1.4, 0)]  # thaw_slump_planar.yaml, in the slope's frame
-PLANAR_ONSET_DEPTH = 0.0259 / (1 - 0.382)  # its header: the thaw depth where FS(X) = 1
+def planar_slope_geometry(folder):
+    """The layer's initial outline (top and free end, in the slope's frame) and the thaw depth at
+    which the drained infinite-slope factor of safety of the thawed layer is 1 (ψ = 0, Davis's
+    strength c′ cos φ′ and sin φ′: FS(X) = (γ′/γ) sin φ′ / tan β + c′ cos φ′ / (γ X sin β cos β)),
+    from the run's resolved scene."""
+    scene = frostplot.run_summary(folder)["resolved_scene"]
+    (soil,) = scene["materials"].values()  # the scene has one material
+    n, water = soil["porosity"], soil["water_density"]
+    density = (1 - n) * soil["solid_density"] + n * water
+    gx, gy = scene["gravity"][:2]
+    beta, g = np.arctan2(gx, -gy), np.hypot(gx, gy)
+    model = soil["mechanical_model"]
+    phi = np.radians(model["friction_angle"])
+    frictional = (density - water) / density * np.sin(phi) / np.tan(beta)
+    cohesive = model["cohesion"] * np.cos(phi) / (density * g * np.sin(beta) * np.cos(beta))
+    right, top = scene["regions"][0]["shape"]["box"]["max"]
+    return [(0, top), (right, top), (right, 0)], cohesive / (1 - frictional)
 
 
 def planar_slump(folders, png, frame):
@@ -471,15 +486,15 @@ def planar_slump(folders, png, frame):
     deviatoric strain and displacement at one frame, in the slope's frame, with the thaw front and
     the initial surface; below, thaw depth and movement against time with the thaw depth at which
     the infinite-slope factor of safety falls to 1."""
+    surface, onset_depth = planar_slope_geometry(folders[0])
     fig, axes = plt.subplots(len(folders) + 1, 2, figsize=(15, 2.6 * len(folders) + 3.4), squeeze=False)
     for row, folder in zip(axes[:-1], folders):
         name = os.path.basename(folder.rstrip("/"))
         fr = frostplot.read_fields.read_frames(folder)[frame]
         u = np.asarray(fr["fields"]["displacement"])
         slump_frame_panel(row[0], fig, fr, f"{name}: plastic deviatoric strain", fr["fields"]["plastic_deviatoric_strain"],
-                          np.linspace(0, 2, 11), "viridis", "plastic deviatoric strain", PLANAR_SURFACE)
-        slump_frame_panel(row[1], fig, fr, f"{name}: u_x (downslope)", u[:, 0], None, "viridis", "u_x [m]",
-                          PLANAR_SURFACE)
+                          np.linspace(0, 2, 11), "viridis", "plastic deviatoric strain", surface)
+        slump_frame_panel(row[1], fig, fr, f"{name}: u_x (downslope)", u[:, 0], None, "viridis", "u_x [m]", surface)
         for ax in row:
             ax.set(xlim=(0, 3.5), ylim=(0, 0.28))
     a, b = axes[-1]
@@ -489,7 +504,7 @@ def planar_slump(folders, png, frame):
         a.plot(m["time_s"], m["thaw_depth_middle"], f"C{i}", label=f"{name}: thaw depth at x = 0.7 m")
         b.plot(m["time_s"], m["surface_middle_x"], f"C{i}", label=f"{name}: surface point from x = 0.7 m")
         b.plot(m["time_s"], m["toe_x"], f"C{i}--", label=f"{name}: top corner of the free end")
-    a.axhline(PLANAR_ONSET_DEPTH, color="k", ls=":", label="FS = 1 (infinite slope, drained)")
+    a.axhline(onset_depth, color="k", ls=":", label=f"FS = 1 (infinite slope, drained): {onset_depth:.3f} m")
     a.set(xlabel="t [s] = days of thaw", ylabel="depth [m]", title="thaw depth (S_l = ½)")
     b.set(xlabel="t [s] = days of thaw", ylabel="u_x [m]", title="downslope movement")
     a.legend(fontsize=7)
