@@ -258,19 +258,25 @@ def rock_label(folder):
 
 
 def rock(folders, png):
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7))
+    # Row 2: the strain the stress answers to, ε_rr less the grains' free thermal strain — what
+    # the paper's code writes as its strain (its particles add −β ΔT to it), so its Fig. 17C–D.
+    fig, axes = plt.subplots(3, 2, figsize=(11, 10))
     for folder in folders:
         m = metrics(folder)
         t = m["time_s"] / 3600
         label = rock_label(folder)
         for k, point in enumerate("AB"):
+            strain = m[f"radial_strain_{point}"]
             axes[0, k].plot(t, m[f"T_{point}"], label=label)
-            axes[1, k].plot(t, 1e6 * m[f"radial_strain_{point}"], label=label)
+            axes[1, k].plot(t, 1e6 * strain, label=label)
+            axes[2, k].plot(t, 1e6 * (strain - m[f"thermal_strain_{point}"]), label=label)
     for k, (point, d) in enumerate((("A", 1), ("B", 4))):
-        axes[0, k].axhline(0, color="k", lw=0.5)
-        axes[1, k].axhline(0, color="k", lw=0.5)
+        for row in range(3):
+            axes[row, k].axhline(0, color="k", lw=0.5)
         axes[0, k].set(xlabel="t [h]", ylabel="T [°C]", title=f"temperature at {point} ({d} cm from the wall)")
-        axes[1, k].set(xlabel="t [h]", ylabel="radial strain ε_rr [10⁻⁶]", title=f"radial strain at {point}")
+        axes[1, k].set(xlabel="t [h]", ylabel="ε_rr [10⁻⁶]", title=f"radial strain at {point} (total)")
+        axes[2, k].set(xlabel="t [h]", ylabel="ε_rr − thermal strain [10⁻⁶]",
+                       title=f"radial strain at {point} less the grains' thermal strain")
     axes[1, 0].legend(fontsize=8)
     frostplot.save(fig, png)
     root, ext = os.path.splitext(png)

@@ -168,6 +168,7 @@ MechanicalPhysics<Dim>::MechanicalPhysics(const ParamSet& p) : params_(p) {
   stress_ = FieldHandle::particle("stress", 6, FieldKind::SymmetricTensor);
   stress_start_ = FieldHandle::particle(ParticleStore::history_name("stress"), 6, FieldKind::SymmetricTensor);
   strain_ = FieldHandle::particle("strain", 6, FieldKind::SymmetricTensor);
+  grain_thermal_strain_ = FieldHandle::particle("thermal_strain");
   deformation_ = FieldHandle::particle("deformation_gradient", 9, FieldKind::Tensor);
   inertia_ = FieldHandle::particle("skeleton_inertia");
   shear_ = FieldHandle::particle("shear_modulus");
@@ -207,6 +208,9 @@ void MechanicalPhysics<Dim>::setup(Kernel<Dim>& kernel) {
   kernel.declare_field("displacement", "m", Dim, 0.0, FieldKind::Vector);
   kernel.declare_history("stress", "Pa", 6, 0.0, FieldKind::SymmetricTensor);
   kernel.declare_field("strain", "1", 6, 0.0, FieldKind::SymmetricTensor);
+  // strain − thermal_strain·I is the strain the stress answers to (what the paper's code writes as
+  // its strain); it stays 0 without a thermal physics or a thermal expansion.
+  kernel.declare_field("thermal_strain", "1", 1, 0.0);
   kernel.declare_field("deformation_gradient", "1", 9, 0.0, FieldKind::Tensor);
   kernel.declare_field("skeleton_inertia", "kg/m^3");  // the skeleton's (mass-scaled) density
   kernel.declare_field("shear_modulus", "Pa");
@@ -293,7 +297,7 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
                                        velocity_.read(),          stress_start_.read(), deformation_.read(),
                                        temperature_.optional_read(), saturation_.optional_read(),
                                        pore_pressure_.optional_read()};
-  std::vector<FieldRef> start_writes = {node_velocity_.write(), stress_.write(),  strain_.write(),
+  std::vector<FieldRef> start_writes = {node_velocity_.write(), stress_.write(),  strain_.write(), grain_thermal_strain_.write(),
                                         deformation_.write(),   porosity_.write(), inertia_.write(),
                                         shear_.write()};
   for (auto& h : variables_start_) start_reads.push_back(h.read());
@@ -530,6 +534,7 @@ void MechanicalPhysics<Dim>::update_stress() {
   auto inertia = inertia_.mutable_values();
   const DensityView density = density_view();
   const bool two_phase = liquid_drag_.bound();
+  const auto grain_strain = thermal ? grain_thermal_strain_.mutable_values() : std::span<double>{};
   long invalid = -1;
   // The step's volume ratio J and the grains' expansion 1 + β_s ΔT give the new porosity from the
   // conserved solid volume, and the porosity the skeleton's inertia.
@@ -590,6 +595,7 @@ void MechanicalPhysics<Dim>::update_stress() {
       }
       for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
       for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
+      if (!grain_strain.empty()) grain_strain[p] += thermal_strain;
       if (thermal) previous_T_[p] = T[p];
       if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
         thermal_strain_[p] = thermal_strain;

@@ -141,6 +141,8 @@ class MechanicalPhysics final : public Physics {
   // ---- fields (bound by the kernel once the step is resolved)
   FieldHandle position_, half_size_, volume_, porosity_, velocity_, displacement_, stress_, stress_start_, strain_, deformation_,
       inertia_, shear_, temperature_, saturation_, pore_pressure_, liquid_drag_, liquid_reaction_, liquid_share_;
+  /// The grains' accumulated free thermal strain on each normal component, β_s (T − T_0)/3.
+  FieldHandle grain_thermal_strain_;
   FieldHandle node_velocity_, node_predicted_, node_increment_, node_pressure_, node_mobility_, node_group_;
   std::vector<InternalVariable> variable_list_;             ///< internal variables of every model, once each
   std::vector<FieldHandle> variables_, variables_start_;    ///< their particle fields
@@ -150,7 +152,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<double> particle_mass_;  ///< without pore-water flow: each particle's constant mass
   std::vector<std::uint8_t> failed_;
   // ---- cell-averaged volumetric strain (only with cell_average_)
-  std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step
+  std::vector<double> thermal_strain_;            ///< per particle: its thermal strain of the step (one component)
   std::vector<double> volume_ratio_;              ///< per particle: its kinematic volume ratio J of the step
   std::vector<std::size_t> cell_of_;              ///< per particle: its grid cell
   std::vector<double> cell_volume_, cell_mean_;   ///< per cell: Σ V and the volume-weighted mean (average_over_cells)
