@@ -297,9 +297,9 @@ std::vector<Stage> MechanicalPhysics<Dim>::stages() {
                                        velocity_.read(),          stress_start_.read(), deformation_.read(),
                                        temperature_.optional_read(), saturation_.optional_read(),
                                        pore_pressure_.optional_read()};
-  std::vector<FieldRef> start_writes = {node_velocity_.write(), stress_.write(),  strain_.write(), grain_thermal_strain_.write(),
-                                        deformation_.write(),   porosity_.write(), inertia_.write(),
-                                        shear_.write()};
+  std::vector<FieldRef> start_writes = {node_velocity_.write(), stress_.write(),   strain_.write(),
+                                        grain_thermal_strain_.write(), deformation_.write(), porosity_.write(),
+                                        inertia_.write(),       shear_.write()};
   for (auto& h : variables_start_) start_reads.push_back(h.read());
   for (auto& h : variables_) start_writes.push_back(h.write());
   return {
