@@ -595,8 +595,10 @@ void MechanicalPhysics<Dim>::update_stress() {
       }
       for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
       for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
-      if (!grain_strain.empty()) grain_strain[p] += thermal_strain;
-      if (thermal) previous_T_[p] = T[p];
+      if (thermal) {
+        grain_strain[p] += thermal_strain;
+        previous_T_[p] = T[p];
+      }
       if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
         thermal_strain_[p] = thermal_strain;
         volume_ratio_[p] = J_ratio;
