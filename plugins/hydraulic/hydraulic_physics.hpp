@@ -172,7 +172,7 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> values_;
   bool preconditioner_built_ = false;  ///< for the current system
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
-  bool refresh_due_ = false;           ///< the iteration count grew by half since the last update
+  bool refresh_due_ = false;           ///< the iteration count grew by more than 2 since the last update
   /// The rigid plates' rows the coupled graph was built with (group_rows() at the time).
   std::vector<std::vector<std::size_t>> graph_groups_;
   // The solver's state in a checkpoint: the graph's plate rows (flattened: count, then each

@@ -354,8 +354,10 @@ void HydraulicPhysics::account_boundary_inflow() {
 void HydraulicPhysics::solve_pressure() {
   assemble();
   // The matrix changes every step a thermal physics moves the ice, but only near the front:
-  // the preconditioner of an earlier step stays good. It is refreshed when the iteration count
-  // has grown by half over the count right after the last refresh (and built on a new graph).
+  // the preconditioner of an earlier step stays good for a while. A refresh (new values on the
+  // kept aggregates) costs about two CG iterations (9 % frozen inclusion: 19 ms against 8.7 ms an
+  // iteration at 0.01 m, 4.3 against 2.0 ms at 0.02 m), so it is due as soon as a step needs more
+  // than two iterations over the count right after the last refresh (and built on a new graph).
   const PreconditionerUpdate update = !preconditioner_built_ ? PreconditionerUpdate::Rebuild
                                      : refresh_due_         ? PreconditionerUpdate::Refresh
                                                             : PreconditionerUpdate::Reuse;
@@ -372,7 +374,7 @@ void HydraulicPhysics::solve_pressure() {
     ++preconditioner_updates_;
     preconditioner_built_ = true;
   }
-  refresh_due_ = stats.iterations > 1.5 * iterations_after_refresh_ + 2;
+  refresh_due_ = stats.iterations > iterations_after_refresh_ + 2;
   iterations_total_ += stats.iterations;
   iterations_max_ = std::max<long>(iterations_max_, stats.iterations);
   residual_max_ = std::max(residual_max_, stats.relative_residual);

@@ -2,7 +2,8 @@
 // Race-free, thread-count-independent particle-to-grid scatter.
 //
 // Particles are grouped into blocks by the lowest node of their stencil (blocks of `width`
-// node columns per axis, `width` = the shape function's support), and the blocks are
+// node columns per axis, `width` = the shape function's support, and longer along the first
+// axis, for runs of consecutive particles: coloured_blocks.cpp), and the blocks are
 // coloured like a 2^Dim checkerboard. Two blocks of one colour are at least `width` node
 // columns apart, so their particles never touch a common node: the blocks of a colour can
 // scatter in parallel without atomics. Colours run one after another, and inside a block the
@@ -45,7 +46,7 @@ class ColouredBlocks {
     const bool parallel = order_.size() >= kParallelMinimum;  // see parallel.hpp
     for (int c = 0; c < kGroups; ++c) {
       const std::uint32_t first = colour_begin_[c], last = colour_begin_[c + 1];
-#pragma omp parallel for schedule(dynamic, 4) if (parallel && c < kColours)
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && c < kColours)
       for (std::uint32_t b = first; b < last; ++b)
         for (std::uint32_t k = block_begin_[b]; k < block_begin_[b + 1]; ++k) f(std::size_t{order_[k]});
     }
