@@ -84,6 +84,41 @@ TEST_CASE("a particle outside the grid is reported by the stencil cache", "[shap
   REQUIRE(cache.update(grid, pos, half) == 1);
 }
 
+TEST_CASE("a GIMP domain clipped at the grid's edge keeps a zero gradient sum however little of it is left",
+          "[shape]") {
+  // A particle leaving through x_max: its domain [x − lp, x + lp] ends δ cells inside the grid. On
+  // its last step δ can be ~1e-11; the gradient sum must stay at round-off (a rigid translation
+  // must not strain it) and the two edge nodes take ±1/h (the clipped domain lies in one cell).
+  UniformGrid<2> grid;
+  grid.spacing = {0.02, 0.02};
+  grid.cells = {100, 4};
+  grid.ghost_layers = ghost_layers(ShapeKind::Gimp);
+  const double h = 0.02, edge = 100 * h, lp = 0.25 * h;
+  std::vector<double> deltas = {0.3, 1e-3, 1e-7};
+  for (int k = 1; k <= 64; ++k) deltas.push_back(k * 1.37e-12);  // the rounding of x − lp varies with δ
+  for (const double delta : deltas) {
+    INFO("delta = " << delta << " cells");
+    StencilCache<2> cache;
+    cache.configure(ShapeKind::Gimp);
+    const std::vector<double> pos = {edge + lp - delta * h, 0.035}, half = {lp, lp};
+    REQUIRE(cache.update(grid, pos, half) == -1);
+    double sum = 0, gx = 0, gy = 0, g_edge = 0, g_inner = 0;
+    for (int k = 0; k < cache.per_particle(); ++k) {
+      const auto x = grid.node_position(cache.nodes(0)[k]);
+      sum += cache.weights(0)[k];
+      gx += cache.gradients(0)[2 * k];
+      gy += cache.gradients(0)[2 * k + 1];
+      if (std::abs(x[0] - edge) < 1e-9) g_edge += cache.gradients(0)[2 * k];
+      if (std::abs(x[0] - (edge - h)) < 1e-9) g_inner += cache.gradients(0)[2 * k];
+    }
+    CHECK(sum == Approx(1.0).margin(1e-14));
+    CHECK(std::abs(gx) * h < 1e-14);
+    CHECK(std::abs(gy) * h < 1e-14);
+    CHECK(g_edge * h == Approx(1.0).epsilon(1e-3));
+    CHECK(g_inner * h == Approx(-1.0).epsilon(1e-3));
+  }
+}
+
 TEST_CASE("GIMP particles filling the grid to its edge stay inside it for any cell size", "[shape]") {
   // Round-off in (x − origin)/h once gave the node past the last one a ~1e-27 weight, so the
   // particle in the last cell counted as outside and lost its whole stencil (bench/stability,

@@ -2,6 +2,7 @@
 // The 1-D shape functions themselves, inline: shape_1d() (shape_function.hpp) calls them, and
 // StencilCache::update inlines them with the kind known at compile time (one branch-free call
 // per axis instead of an out-of-line call and a switch per particle). Same code, same bits.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -29,6 +30,18 @@ inline void gimp(double r, double lp, double tol, double& s, double& ds) {
     s = 1.0 - (r * r + lp * lp) / (2.0 * lp);
     ds = -r / lp;
   }
+}
+
+/// uGIMP gradients of a domain [lo, hi] (cell units) from the hat at its two ends,
+/// dS_k/dx = (N(hi − k) − N(lo − k)) / ((hi − lo) h), for the nodes base, base + 1, base + 2.
+/// Analytically gimp()'s ds; used for a domain clipped at the grid's edge, whose width can shrink
+/// to ~1e-11 cells as it leaves: there gimp()'s −r/lp, with r = xi − node rounded to eps·|xi|, put a
+/// 1e-4 error in Σ_k dS_k (a rigidly moving particle strained as it left), while here the edge's
+/// two nodes take the same rounded hat value with opposite signs and Σ_k dS_k stays at round-off.
+inline void gimp_gradients_of_ends(double lo, double hi, int base, double inv_h, double* gradient) {
+  const auto hat = [](double r) { return std::max(0.0, 1.0 - std::abs(r)); };
+  const double scale = inv_h / (hi - lo);
+  for (int k = 0; k < 3; ++k) gradient[k] = (hat(hi - (base + k)) - hat(lo - (base + k))) * scale;
 }
 
 inline void bspline(double r, double tol, double& s, double& ds) {

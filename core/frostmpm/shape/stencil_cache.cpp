@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
+#include <utility>
 
 namespace frostmpm {
 
@@ -38,6 +40,7 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
       const double h = grid.spacing[d];
       double xi = (positions[p * Dim + d] - grid.origin[d]) / h;
       double half = half_sizes[p * Dim + d] / h;
+      std::optional<std::pair<double, double>> clipped;  // the domain's ends inside the grid
       // GIMP integrates over the particle domain inside the grid, Ω_p ∩ Ω (paper Eq. 58): a domain
       // that reaches past the grid's edge (a particle pressed against a fixed boundary) is clipped
       // to it, which keeps the partition of unity. A domain wholly outside has left the grid.
@@ -55,9 +58,12 @@ long update_stencils(const UniformGrid<Dim>& grid, std::span<const double> posit
           }
           xi = 0.5 * (lo + hi);
           half = 0.5 * (hi - lo);
+          clipped = {lo, hi};
         }
       }
       base[d] = shape_kernels::shape_1d<Kind>(xi, h, half, w[d].data(), g[d].data());
+      // A clipped domain's gradients from its ends (exact cancellation however narrow it is).
+      if (clipped) shape_kernels::gimp_gradients_of_ends(clipped->first, clipped->second, base[d], 1.0 / h, g[d].data());
       // A support node past the grid is harmless when its weight is zero (GIMP particles at
       // the domain edge); it is then pointed at a valid node. A domain that ends past the edge
       // by less than the round-off above was not clipped and may hold a ~1e-26 weight there
