@@ -707,14 +707,19 @@ double Simulation::plan_step(const LoopState& loop) const {
   }
   if (max_dt_ > 0) dt = std::min(dt, max_dt_);
   if (!std::isfinite(dt)) dt = end_time_ - time_;
-  // Land exactly on output, metrics and end times without leaving a sliver step: when the
-  // target is less than two steps away, split the remaining gap in two.
+  // Land exactly on the nearest output, metrics or end time in equal steps: the fewest steps of at
+  // most dt that reach it, each gap / n. A full-length run ended by one short step to the target
+  // modulates Δt with the output period, and the explicit skeleton's kick–drift pair then pumps
+  // elastic modes at that period: a free block flying at 0.25 m/s with metrics every 0.002 s
+  // (55 steps of 3.55e-5 s and two of 2.4e-5 s) grew rounding noise tenfold every 0.1 s, to
+  // 2e-3 m/s by 1.6 s; in equal steps it stays at 1e-13 m/s.
+  double gap = std::numeric_limits<double>::infinity();
   for (double target : {loop.next_output, metrics_every_ > 0 ? std::min(loop.next_metrics, end_time_) : end_time_,
-                        end_time_}) {
-    const double gap = target - time_;
-    if (gap <= eps) continue;
-    if (dt >= gap - eps) dt = gap;
-    else if (2 * dt > gap) dt = 0.5 * gap;
+                        end_time_})
+    if (target - time_ > eps) gap = std::min(gap, target - time_);
+  if (std::isfinite(gap)) {
+    if (dt >= gap - eps) return gap;
+    dt = gap / std::ceil(gap / dt - 1e-9);
   }
   return dt;
 }
