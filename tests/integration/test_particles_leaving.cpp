@@ -10,53 +10,34 @@
 #include <filesystem>
 #include <thread>
 
+#include "scene_runs.hpp"
 #include "test_support.hpp"
 
 using namespace frostmpm::test;
 
 namespace {
 
-// A free elastic block 0.3 m × 0.2 m at 5 °C flying at 0.25 m/s towards the grid's x_max edge
-// (x = 1 m), nothing else acting. Particle columns (spacing 0.01 m, half-width 0.005 m) start at
-// x_k = 0.505 + 0.01 k, k = 0..29, 20 rows each; column k is outside the grid once its domain's
-// left edge passes x = 1: 0.5 + 0.01 k + 0.25 t > 1. At t = 1.606 s that is k ≥ 10 (k = 9 ends
-// 8.5 mm inside, k = 10 1.5 mm outside): 20 columns, 400 particles leave, 200 remain.
-constexpr const char* kScene = R"(task: simulation
-grid: {cells: [50, 20], cell_size: 0.02, particles_leaving: remove}
-time: {end: 1.606}
-physics:
-  thermal: {scheme: explicit}
-  mechanical: {}
-materials:
-  soil:
-    porosity: 0.3
-    solid_density: 2000
-    solid_heat_capacity: 800
-    solid_conductivity: 2.0
-    water_heat_capacity: 4182
-    water_conductivity: 0.6
-    sfcc: {model: exponential, width: 0.5, residual_saturation: 0.05, freezing_point: -100}
-    mechanical_model: {model: linear_elastic, youngs_modulus: 1.0e8, poisson_ratio: 0.3}
-regions:
-  - shape: {box: {min: [0.5, 0.1], max: [0.8, 0.3]}}
-    material: soil
-    initial: {temperature: 5.0, solid_velocity.x: 0.25}
-output: {every: 0.2, metrics_every: 0.01, fields: [temperature, particle_id, solid_velocity], progress: false}
-checkpoint: {every_steps: 2000}
-probes:
-  - {name: T_min, type: min, field: temperature}
-  - {name: T_max, type: max, field: temperature}
-)";
+// configs/verification/flying_block.yaml — a free elastic block 0.3 m × 0.2 m at 5 °C flying at
+// 0.25 m/s — on a grid whose x_max edge (x = 1 m) it crosses. Particle columns (spacing 0.01 m,
+// half-width 0.005 m) start at x_k = 0.505 + 0.01 k, k = 0..29, 20 rows each; column k is outside
+// the grid once its domain's left edge passes x = 1: 0.5 + 0.01 k + 0.25 t > 1. At t = 1.606 s that
+// is k ≥ 10 (k = 9 ends 8.5 mm inside, k = 10 1.5 mm outside): 20 columns, 400 particles leave,
+// 200 remain.
+const std::string kBlock =
+    verification_scene("flying_block.yaml") +
+    " --set 'grid.cells=[50, 20]' --set grid.particles_leaving=remove --set time.end=1.606"
+    " --set 'output={every: 0.2, metrics_every: 0.01, fields: [temperature, particle_id, solid_velocity],"
+    " progress: false}' --set 'checkpoint={every_steps: 2000}'"
+    " --set 'probes=[{name: T_min, type: min, field: temperature}, {name: T_max, type: max, field: temperature}]'";
 
 }  // namespace
 
 TEST_CASE("particles leaving the grid: a clean stop by default, or removed with their heat and mass counted",
           "[leaving]") {
   TempDir dir;
-  write_file(dir.file("block.yaml"), kScene);
 
   SECTION("stop (the default) names the particle, its region and the time, exit 3") {
-    const auto r = run_frostmpm("run " + dir.file("block.yaml") + " -o " + dir.file("stop") +
+    const auto r = run_frostmpm("run " + kBlock + " -o " + dir.file("stop") +
                                 " --set grid.particles_leaving=stop --set 'output.fields=[temperature]'");
     INFO(r.output);
     REQUIRE(r.exit_code == 3);
@@ -70,7 +51,7 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
 
   SECTION("remove: the closed-form count leaves, heat and mass are accounted, the rest flies on") {
     const std::string out = dir.file("remove");
-    const auto r = run_frostmpm("run " + dir.file("block.yaml") + " -o " + out);
+    const auto r = run_frostmpm("run " + kBlock + " -o " + out);
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(run_json(out, "['run']['removed_particles']") == "400");
@@ -96,9 +77,12 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
 
   SECTION("a restart whose checkpoint holds particles the last step moved off the grid counts them") {
     // Column k = 28's domain passes x = 1 at t = 0.88 s: the run ending 5 µs later checkpoints
-    // after the step that moved it off, before the next step would remove it.
+    // after the step that moved it off, before the next step would remove it. (Metrics every
+    // 0.0123 s: a row at 0.88 s would land a step on the crossing itself, where round-off
+    // decides on which side the column stands.)
     const std::string out = dir.file("edge");
-    const auto first = run_frostmpm("run " + dir.file("block.yaml") + " -o " + out + " --set time.end=0.880005");
+    const auto first = run_frostmpm("run " + kBlock + " -o " + out +
+                                    " --set time.end=0.880005 --set output.metrics_every=0.0123");
     REQUIRE(first.exit_code == 0);
     const auto removed_before = std::stoi(run_json(out, "['run']['removed_particles']"));
     CHECK(removed_before >= 20);
@@ -113,11 +97,11 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
   }
 
   SECTION("a run stopped after particles left continues with --restart to the same metrics") {
-    const auto reference = run_frostmpm("run " + dir.file("block.yaml") + " -o " + dir.file("reference"));
+    const auto reference = run_frostmpm("run " + kBlock + " -o " + dir.file("reference"));
     REQUIRE(reference.exit_code == 0);
     const std::string out = dir.file("stopped");
     {
-      BackgroundRun run("run " + dir.file("block.yaml") + " -o " + out, dir.file("stdout"), dir.file("stderr"));
+      BackgroundRun run("run " + kBlock + " -o " + out, dir.file("stdout"), dir.file("stderr"));
       // Stop once the metrics pass 1.0 s, when 80 particles have left (the checkpoint at the
       // stop holds fewer particles than the scene makes).
       const auto start = std::chrono::steady_clock::now();

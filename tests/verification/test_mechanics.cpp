@@ -116,40 +116,11 @@ TEST_CASE("self-weight column loaded suddenly, undamped: the surface swings to 2
 TEST_CASE("a free elastic block flying at constant velocity stays a rigid translation: equal steps between "
           "metrics rows",
           "[verification][mechanics]") {
-  // The exact motion: every particle at 0.25 m/s forever, no stress. Metrics every 0.002 s against
-  // a stable step of 3.55e-5 s: when the run took 55 full steps and then two of 0.67 to each row,
-  // Δt varied with the metrics period and the explicit kick–drift pair pumped the block's elastic
-  // modes — the particles' velocity noise grew tenfold every 0.1 s, from 1e-13 to 2e-3 m/s at
-  // 1.6 s. Landing on each row in equal steps it stays at round-off (measured 3e-13 m/s).
+  // Exact: every particle at 0.25 m/s, no stress (the scene's header). Landed on each metrics row
+  // in full steps and a short one, the velocity noise grew to 1.9e-3 m/s by 1.6 s; in equal steps
+  // it stays at round-off (measured 1.5e-13 m/s).
   TempDir dir;
-  write_file(dir.file("block.yaml"), R"(task: simulation
-grid: {cells: [100, 20], cell_size: 0.02}
-time: {end: 1.6}
-physics:
-  thermal: {scheme: explicit}
-  mechanical: {}
-materials:
-  soil:
-    porosity: 0.3
-    solid_density: 2000
-    solid_heat_capacity: 800
-    solid_conductivity: 2.0
-    water_heat_capacity: 4182
-    water_conductivity: 0.6
-    sfcc: {model: exponential, width: 0.5, residual_saturation: 0.05, freezing_point: -100}
-    mechanical_model: {model: linear_elastic, youngs_modulus: 1.0e8, poisson_ratio: 0.3}
-regions:
-  - shape: {box: {min: [0.5, 0.1], max: [0.8, 0.3]}}
-    material: soil
-    initial: {temperature: 5.0, solid_velocity.x: 0.25}
-output: {every: 0, metrics_every: 0.002}
-probes:
-  - {name: vx_max, type: max, field: solid_velocity.x}
-  - {name: vx_min, type: min, field: solid_velocity.x}
-  - {name: vy_max, type: max, field: solid_velocity.y}
-  - {name: vy_min, type: min, field: solid_velocity.y}
-)");
-  const auto t = run_scene(dir, dir.file("block.yaml"), {}, "block");
+  const auto t = run_scene(dir, verification_scene("flying_block.yaml"), {}, "block");
   double noise = 0;
   for (const auto& row : t.rows)
     noise = std::max({noise, row[t.column("vx_max")] - 0.25, 0.25 - row[t.column("vx_min")],
