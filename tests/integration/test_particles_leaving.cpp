@@ -58,9 +58,9 @@ TEST_CASE("particles leaving the grid: a clean stop by default, or removed with 
     CHECK(run_json(out, "['run']['particles']") == "200");
     // Mass: 400 × V_p ρ_m, V_p = 1e-4 m², ρ_m = 0.7 · 2000 + 0.3 · 1000 (liquid water at 5 °C).
     CHECK(run_counter(out, "mechanical.mass_removed_kg") == Approx(400 * 1e-4 * 1700).epsilon(1e-9));
-    // The 200 left move on at 0.25 m/s: ½ m v², measured 6e-13 off. A domain clipped at the edge
+    // The 200 left move on at 0.25 m/s: ½ m v², measured 5e-13 off. A domain clipped at the edge
     // narrows to ~1e-11 cells on its last step: with its gradients from the closed form the rigid
-    // motion strained it (2e-6 of the energy); so did a short step before each metrics row.
+    // motion strained it and the rest took 2e-6 of the energy.
     CHECK(run_counter(out, "mechanical.kinetic_energy_J") == Approx(0.5 * 200 * 1e-4 * 1700 * 0.0625).epsilon(1e-10));
     // Heat: nothing enters, so the stored heat falls by what left, two thirds of the block's.
     const double removed = run_counter(out, "thermal.energy_removed_J");
