@@ -44,9 +44,18 @@
 #define TEUCHOS_STANDARD_PARAMETER_ENTRY_VALIDATORS_H
 #endif
 #include <MueLu_CreateTpetraPreconditioner.hpp>
+#include <MueLu_Hierarchy.hpp>
+#include <MueLu_Level.hpp>
 #include <MueLu_TpetraOperator.hpp>
+#include <Xpetra_CrsMatrixWrap.hpp>
+#include <Xpetra_Matrix.hpp>
+#include <Xpetra_TpetraCrsMatrix.hpp>
 
+#include "frostmpm/linalg/conjugate_gradient.hpp"
+#include "frostmpm/linalg/csr_matrix.hpp"
 #include "frostmpm/linalg/mpi_session.hpp"
+#include "frostmpm/linalg/multigrid_cycle.hpp"
+#include "frostmpm/parallel/parallel.hpp"
 
 namespace frostmpm {
 namespace {
@@ -119,6 +128,46 @@ void validate_options(const SolverOptions& o) {
   }
 }
 
+using XMatrix = Xpetra::Matrix<SC, LO, GO, NT>;
+using XOperator = Xpetra::Operator<SC, LO, GO, NT>;
+
+/// The Tpetra matrix inside a MueLu level's operator.
+RCP<const Matrix> tpetra_matrix(const RCP<XOperator>& op) {
+  const auto wrap = Teuchos::rcp_dynamic_cast<const Xpetra::CrsMatrixWrap<SC, LO, GO, NT>>(op, true);
+  const auto tpetra =
+      Teuchos::rcp_dynamic_cast<const Xpetra::TpetraCrsMatrix<SC, LO, GO, NT>>(wrap->getCrsMatrix(), true);
+  return tpetra->getTpetra_CrsMatrix();
+}
+
+/// A MueLu level matrix as CSR: its rows in the order of `rows` (which must be its row map's
+/// order), its columns numbered as the rows of `columns` (the next level's map for a
+/// prolongator, its own row map for an operator).
+CsrMatrix to_csr(const Matrix& M, const Map& rows, const Map& columns) {
+  const auto& row_map = *M.getRowMap();
+  const auto& column_map = *M.getColMap();
+  CsrMatrix csr;
+  csr.rows = row_map.getNodeNumElements();
+  csr.cols = columns.getNodeNumElements();
+  if (!row_map.isSameAs(rows))
+    throw std::logic_error("SparseSystem: a multigrid level's rows are not in its map's order");
+  std::vector<int> column_of(column_map.getNodeNumElements());  // column-map index → ours
+  for (std::size_t c = 0; c < column_of.size(); ++c) {
+    column_of[c] = columns.getLocalElement(column_map.getGlobalElement(LO(c)));
+    if (column_of[c] < 0) throw std::logic_error("SparseSystem: a multigrid level's column lies outside its map");
+  }
+  const auto local = M.getLocalMatrixHost();
+  csr.offsets.resize(csr.rows + 1);
+  for (std::size_t i = 0; i <= csr.rows; ++i) csr.offsets[i] = std::size_t(local.graph.row_map(i));
+  const std::size_t entries = csr.offsets.back();
+  csr.columns.resize(entries);
+  csr.values.resize(entries);
+  for (std::size_t k = 0; k < entries; ++k) {
+    csr.columns[k] = column_of[std::size_t(local.graph.entries(k))];
+    csr.values[k] = local.values(k);
+  }
+  return csr;
+}
+
 }  // namespace
 
 struct SparseSystem::Impl {
@@ -128,10 +177,17 @@ struct SparseSystem::Impl {
   std::vector<int> columns;         ///< as given
   std::vector<LO> sorted_columns;   ///< per row, ascending
   std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
-  std::vector<double> values;
   std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
-  bool values_dirty = true;
+  bool values_dirty = true;         ///< values changed since the last solve
+  bool tpetra_values_dirty = true;  ///< values not yet in Tpetra's matrix
   SolverOptions options;
+
+  // ---- our own threaded CG (see use_own_krylov) ----
+  bool own_krylov = false;
+  /// The caller's pattern (order of column_indices) with the current values: the matrix our CG
+  /// iterates on, and the values every other path copies from.
+  CsrMatrix current;
+  std::unique_ptr<LinearPreconditioner> own_preconditioner;
 
   // ---- Trilinos objects (absent when n == 0) ----
   RCP<const Teuchos::Comm<int>> comm;
@@ -153,7 +209,18 @@ struct SparseSystem::Impl {
         options(std::move(opts)) {
     validate_options(options);
     validate_and_sort_pattern();
-    values.assign(columns.size(), 0.0);
+    // Debian's Trilinos 13.2 builds Kokkos with its Serial back end only (KokkosCore_config.h
+    // leaves KOKKOS_ENABLE_OPENMP undefined), so Belos and every Tpetra kernel run on one core
+    // whatever --threads says: in the 9 % frozen inclusion at 0.01 m the two solves were 80 %
+    // of a 2-thread run. CG with no, Jacobi or multigrid preconditioning therefore runs here,
+    // threaded with OpenMP; MueLu still builds (and refreshes) the multigrid hierarchy, which
+    // is set-up work done rarely, and MultigridCycle applies it. GMRES and ILU stay with Belos
+    // and Ifpack2.
+    own_krylov = options.method == "cg" && options.preconditioner != "ilu";
+    current.rows = current.cols = n;
+    current.offsets = offsets;
+    current.columns = columns;
+    current.values.assign(columns.size(), 0.0);
     if (n > 0) build_trilinos_objects();
   }
 
@@ -258,10 +325,16 @@ struct SparseSystem::Impl {
     {
       const auto device_values = matrix->getLocalValuesView();
       const auto host_values = Kokkos::create_mirror_view(device_values);
-      for (std::size_t k = 0; k < values.size(); ++k) host_values(storage_position[k]) = values[k];
+      for (std::size_t k = 0; k < current.values.size(); ++k) host_values(storage_position[k]) = current.values[k];
       Kokkos::deep_copy(device_values, host_values);
     }
     matrix->fillComplete();
+    tpetra_values_dirty = false;
+  }
+
+  /// The caller's values into the matrix the solver iterates on (ours iterates on `current`).
+  void take_values() {
+    if (!own_krylov) upload_values();
     values_dirty = false;
   }
 
@@ -273,6 +346,10 @@ struct SparseSystem::Impl {
 
   void build_preconditioner(bool refresh) {
     const auto& kind = options.preconditioner;
+    if (own_krylov) {
+      build_own_preconditioner(refresh);
+      return;
+    }
     copy_values_to_preconditioner_matrix();
     if (kind == "jacobi" || kind == "ilu") {
       if (ifpack2.is_null()) {
@@ -291,55 +368,95 @@ struct SparseSystem::Impl {
         ifpack2->initialize();
       }
       ifpack2->compute();  // from the current values alone
-      if (refresh)
-        source.refreshed = values;
-      else
-        source = {values, {}};
+      record_source(refresh);
       problem->setRightPrec(ifpack2);
     } else if (kind == "multigrid") {
-      Teuchos::ParameterList params;
-      params.set("verbosity", "none");
-      params.set("multigrid algorithm", "sa");
-      params.set("coarse: max size", 200);
-      // Aggregates follow the strong couplings only (|a_ij| ≥ 0.02 √(a_ii a_jj)): across a
-      // permeability jump of orders of magnitude (frozen against thawed soil) an aggregate
-      // that straddles the jump interpolates the stiff side from the soft one. With it the 9 %
-      // frozen inclusion needs 12–15 CG iterations per step instead of 18–24 (0.04–0.01 m).
-      params.set("aggregation: drop tol", 0.02);
-      // Symmetric smoothing keeps the V-cycle symmetric, as CG needs.
-      params.set("smoother: type", "RELAXATION");
-      params.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
-      params.sublist("smoother: params").set("relaxation: sweeps", 1);
-      // The coarsest level (≤ 200 unknowns) solved exactly (KLU2 through Amesos2, which gathers
-      // a distributed coarse matrix itself): an inexact coarse solve lets the iteration count
-      // grow with refinement.
-      params.set("coarse: type", "KLU2");
-      // A refresh keeps the aggregates and prolongators and recomputes the coarse operators and
-      // smoothers from the new values (MueLu's "RP" reuse).
-      params.set("reuse: type", "RP");
-      bool refreshed = false;
-      if (!muelu.is_null() && refresh) {
-        // The reuse keeps the coarse operators' graphs, which MueLu built from the nonzero
-        // values: an entry that was zero then (a row fixed as a boundary or a dry node, which
-        // may become free when particles move or ice melts) does not fit, and MueLu throws.
-        // Then the preconditioner is built anew.
-        try {
-          MueLu::ReuseTpetraPreconditioner(preconditioner_matrix, *muelu);
-          refreshed = true;
-        } catch (const std::exception&) {
-          refreshed = false;
-        }
-      }
-      if (!refreshed)
-        muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
-      // A refresh depends on the aggregates and prolongators of the build and on the new values.
-      if (refreshed)
-        source.refreshed = values;
-      else
-        source = {values, {}};
+      build_muelu(refresh);
       problem->setRightPrec(muelu);
     }
     have_preconditioner = true;
+  }
+
+  /// The preconditioner of our own CG, from the current values.
+  void build_own_preconditioner(bool refresh) {
+    const auto& kind = options.preconditioner;
+    if (kind == "jacobi") {
+      own_preconditioner = std::make_unique<JacobiPreconditioner>(current);
+      record_source(refresh);
+    } else if (kind == "multigrid") {
+      if (tpetra_values_dirty) upload_values();
+      copy_values_to_preconditioner_matrix();
+      build_muelu(refresh);
+      own_preconditioner = std::make_unique<MultigridCycle>(extract_hierarchy());
+    }
+    have_preconditioner = true;
+  }
+
+  /// MueLu's levels as CSR: the finest is `current` (the values just given to MueLu).
+  MultigridCycle extract_hierarchy() const {
+    const auto hierarchy = muelu->GetHierarchy();
+    std::vector<CsrMatrix> operators{current}, prolongators;
+    RCP<const Map> fine_rows = map;  // level 0: our rows 0 … n − 1 in order
+    for (int l = 1; l < hierarchy->GetNumLevels(); ++l) {
+      const auto level = hierarchy->GetLevel(l);
+      const auto A = tpetra_matrix(level->template Get<RCP<XOperator>>("A"));
+      const auto P = tpetra_matrix(level->template Get<RCP<XOperator>>("P"));
+      operators.push_back(to_csr(*A, *A->getRowMap(), *A->getRowMap()));
+      prolongators.push_back(to_csr(*P, *fine_rows, *A->getRowMap()));
+      fine_rows = A->getRowMap();
+    }
+    return MultigridCycle(std::move(operators), std::move(prolongators));
+  }
+
+  void record_source(bool refreshed) {
+    if (refreshed)
+      source.refreshed = current.values;
+    else
+      source = {current.values, {}};
+  }
+
+  /// MueLu's hierarchy from preconditioner_matrix, refreshed ("RP" reuse) when asked and
+  /// possible; records what it was made from in `source`.
+  void build_muelu(bool refresh) {
+    Teuchos::ParameterList params;
+    params.set("verbosity", "none");
+    params.set("multigrid algorithm", "sa");
+    params.set("coarse: max size", 200);
+    // Aggregates follow the strong couplings only (|a_ij| ≥ 0.02 √(a_ii a_jj)): across a
+    // permeability jump of orders of magnitude (frozen against thawed soil) an aggregate
+    // that straddles the jump interpolates the stiff side from the soft one. With it the 9 %
+    // frozen inclusion needs 12–15 CG iterations per step instead of 18–24 (0.04–0.01 m).
+    params.set("aggregation: drop tol", 0.02);
+    // Symmetric smoothing keeps the V-cycle symmetric, as CG needs (Belos's path; our own
+    // cycle smooths with its own, see multigrid_cycle.hpp).
+    params.set("smoother: type", "RELAXATION");
+    params.sublist("smoother: params").set("relaxation: type", "Symmetric Gauss-Seidel");
+    params.sublist("smoother: params").set("relaxation: sweeps", 1);
+    if (own_krylov) params.set("smoother: pre or post", "none");  // MultigridCycle smooths
+    // The coarsest level (≤ 200 unknowns) solved exactly (KLU2 through Amesos2, which gathers
+    // a distributed coarse matrix itself): an inexact coarse solve lets the iteration count
+    // grow with refinement.
+    params.set("coarse: type", "KLU2");
+    // A refresh keeps the aggregates and prolongators and recomputes the coarse operators and
+    // smoothers from the new values (MueLu's "RP" reuse).
+    params.set("reuse: type", "RP");
+    bool refreshed = false;
+    if (!muelu.is_null() && refresh) {
+      // The reuse keeps the coarse operators' graphs, which MueLu built from the nonzero
+      // values: an entry that was zero then (a row fixed as a boundary or a dry node, which
+      // may become free when particles move or ice melts) does not fit, and MueLu throws.
+      // Then the preconditioner is built anew.
+      try {
+        MueLu::ReuseTpetraPreconditioner(preconditioner_matrix, *muelu);
+        refreshed = true;
+      } catch (const std::exception&) {
+        refreshed = false;
+      }
+    }
+    if (!refreshed)
+      muelu = MueLu::CreateTpetraPreconditioner<SC, LO, GO, NT>(RCP<OP>(preconditioner_matrix), params);
+    // A refresh depends on the aggregates and prolongators of the build and on the new values.
+    record_source(refreshed);
   }
 
   double relative_residual(double b_norm) {
@@ -391,7 +508,7 @@ struct SparseSystem::Impl {
     }
 
     const auto setup_start = Clock::now();
-    if (values_dirty) upload_values();
+    if (values_dirty) take_values();
     if (options.preconditioner != "none") {
       if (update != PreconditionerUpdate::Reuse || !have_preconditioner) {
         build_preconditioner(have_preconditioner && update == PreconditionerUpdate::Refresh);
@@ -400,6 +517,7 @@ struct SparseSystem::Impl {
       }
     }
     stats.setup_seconds = seconds_since(setup_start);
+    if (own_krylov) return solve_own(rhs, x_io, tolerance, stats);
 
     const auto solve_start = Clock::now();
     {
@@ -421,19 +539,9 @@ struct SparseSystem::Impl {
       throw std::invalid_argument("SparseSystem::solve: rhs contains inf or NaN");
     }
 
-    // Belos judges convergence on its recursively updated residual; we judge it on the true
-    // residual and, if rounding left it above the tolerance, continue from the current x.
-    double rel = relative_residual(b_norm);
-    for (int pass = 0; pass < 4 && rel > tolerance; ++pass) {
-      const int remaining = options.max_iterations - stats.iterations;
-      if (remaining <= 0) break;
-      const int its = run_krylov(remaining, tolerance);
-      stats.iterations += its;
-      rel = relative_residual(b_norm);
-      if (its == 0) break;  // no progress possible
-    }
-    stats.relative_residual = rel;
-    stats.converged = std::isfinite(rel) && rel <= tolerance;
+    // Belos judges convergence on its recursive residual, we on the true one.
+    iterate_to_tolerance(stats, tolerance, [&](int remaining) { return run_krylov(remaining, tolerance); },
+                         [&] { return relative_residual(b_norm); });
     {
       auto xv = x->getLocalViewHost(Tpetra::Access::ReadOnly);
       for (std::size_t i = 0; i < n; ++i) x_io[i] = xv(i, 0);
@@ -441,6 +549,58 @@ struct SparseSystem::Impl {
     stats.solve_seconds = seconds_since(solve_start);
     return stats;
   }
+
+  /// Krylov passes (`krylov(iterations left)` returns the iterations it took) from the current x
+  /// until the true relative residual (`residual()`) meets the tolerance: a Krylov method judges
+  /// convergence on its recursively updated residual, which rounding can leave below the true
+  /// one. At most four passes, and none once an iteration budget is spent or a pass stalls.
+  template <class Krylov, class Residual>
+  void iterate_to_tolerance(SolveStats& stats, double tolerance, Krylov&& krylov, Residual&& residual) const {
+    double rel = residual();
+    for (int pass = 0; pass < 4 && rel > tolerance; ++pass) {
+      const int remaining = options.max_iterations - stats.iterations;
+      if (remaining <= 0) break;
+      const int its = krylov(remaining);
+      stats.iterations += its;
+      rel = residual();
+      if (its == 0) break;  // no progress possible
+    }
+    stats.relative_residual = rel;
+    stats.converged = std::isfinite(rel) && rel <= tolerance;
+  }
+
+  /// solve()'s Krylov part on our own CG: the same contract (convergence judged on the true
+  /// residual, up to four passes from the current x).
+  SolveStats solve_own(std::span<const double> rhs, std::span<double> x_io, double tolerance, SolveStats stats) {
+    const auto solve_start = Clock::now();
+    const double b_norm = std::sqrt(reproducible_sum(n, [&](std::size_t i) { return rhs[i] * rhs[i]; }));
+    if (b_norm == 0.0) {
+      std::fill(x_io.begin(), x_io.end(), 0.0);  // A x = 0 has the solution 0
+      stats.converged = true;
+      stats.solve_seconds = seconds_since(solve_start);
+      return stats;
+    }
+    if (!std::isfinite(b_norm)) throw std::invalid_argument("SparseSystem::solve: rhs contains inf or NaN");
+    std::vector<double> residual(n);
+    auto true_residual = [&] {
+      current.residual(rhs, x_io, residual);
+      return std::sqrt(reproducible_sum(n, [&](std::size_t i) { return residual[i] * residual[i]; })) / b_norm;
+    };
+    iterate_to_tolerance(
+        stats, tolerance,
+        [&](int remaining) {
+          try {
+            return conjugate_gradient(current, own_preconditioner.get(), rhs, x_io, tolerance, remaining);
+          } catch (const std::exception& e) {
+            throw std::runtime_error(std::string("SparseSystem: cg solve failed: ") + e.what());
+          }
+        },
+        true_residual);
+    stats.solve_seconds = seconds_since(solve_start);
+    return stats;
+  }
+
+  void mark_values_changed() { values_dirty = tpetra_values_dirty = true; }
 
   void add_to_entry(std::size_t row, std::size_t col, double delta) {
     if (row >= n || col >= n) {
@@ -455,8 +615,8 @@ struct SparseSystem::Impl {
       throw std::out_of_range("SparseSystem::add_to_entry: (" + std::to_string(row) + ", " +
                               std::to_string(col) + ") is not in the sparsity pattern");
     }
-    values[order[static_cast<std::size_t>(it - sorted_columns.begin())]] += delta;
-    values_dirty = true;
+    current.values[order[static_cast<std::size_t>(it - sorted_columns.begin())]] += delta;
+    mark_values_changed();
   }
 };
 
@@ -474,16 +634,16 @@ std::size_t SparseSystem::nonzeros() const { return impl_->columns.size(); }
 const SolverOptions& SparseSystem::options() const { return impl_->options; }
 
 void SparseSystem::set_values(std::span<const double> values) {
-  if (values.size() != impl_->values.size()) {
+  if (values.size() != impl_->current.values.size()) {
     throw std::invalid_argument("SparseSystem::set_values: expected " +
-                                std::to_string(impl_->values.size()) + " values, got " +
+                                std::to_string(impl_->current.values.size()) + " values, got " +
                                 std::to_string(values.size()));
   }
-  std::copy(values.begin(), values.end(), impl_->values.begin());
-  impl_->values_dirty = true;
+  std::copy(values.begin(), values.end(), impl_->current.values.begin());
+  impl_->mark_values_changed();
 }
 
-std::span<const double> SparseSystem::values() const { return impl_->values; }
+std::span<const double> SparseSystem::values() const { return impl_->current.values; }
 
 void SparseSystem::add_to_entry(std::size_t row, std::size_t col, double delta) {
   impl_->add_to_entry(row, col, delta);
@@ -507,24 +667,26 @@ PreconditionerSource SparseSystem::preconditioner_source() const {
 void SparseSystem::restore_preconditioner(const PreconditionerSource& source) {
   Impl& s = *impl_;
   if (source.built.empty() && source.refreshed.empty()) return;  // there was none ("none", or no solve yet)
-  const std::size_t nnz = s.values.size();
+  const std::size_t nnz = s.current.values.size();
   if (source.built.size() != nnz || (!source.refreshed.empty() && source.refreshed.size() != nnz))
     throw std::invalid_argument("SparseSystem::restore_preconditioner: expected " + std::to_string(nnz) +
                                 " values built from and none or as many refreshed from, got " +
                                 std::to_string(source.built.size()) + " and " +
                                 std::to_string(source.refreshed.size()));
   if (s.n == 0 || s.options.preconditioner == "none") return;
-  const std::vector<double> current = s.values;
-  s.values = source.built;
-  s.upload_values();
+  const std::vector<double> kept = s.current.values;
+  s.current.values = source.built;
+  s.mark_values_changed();
+  s.take_values();
   s.build_preconditioner(false);
   if (!source.refreshed.empty()) {
-    s.values = source.refreshed;
-    s.upload_values();
+    s.current.values = source.refreshed;
+    s.mark_values_changed();
+    s.take_values();
     s.build_preconditioner(true);
   }
-  s.values = current;
-  s.values_dirty = true;
+  s.current.values = kept;
+  s.mark_values_changed();
 }
 
 }  // namespace frostmpm

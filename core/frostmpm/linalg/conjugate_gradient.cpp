@@ -1,0 +1,62 @@
+#include "frostmpm/linalg/conjugate_gradient.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "frostmpm/parallel/parallel.hpp"
+
+namespace frostmpm {
+
+JacobiPreconditioner::JacobiPreconditioner(const CsrMatrix& A) : inverse_diagonal_(A.diagonal()) {
+  for (double& d : inverse_diagonal_) d = d != 0 ? 1.0 / d : 1.0;
+}
+
+void JacobiPreconditioner::apply(std::span<const double> r, std::span<double> z) {
+  parallel_for(r.size(), [&](std::size_t i) { z[i] = inverse_diagonal_[i] * r[i]; });
+}
+
+int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner, std::span<const double> b,
+                       std::span<double> x, double tolerance, int max_iterations) {
+  const std::size_t n = A.rows;
+  std::vector<double> r(n), z(n), p(n), q(n);
+  const double b_norm = std::sqrt(reproducible_sum(n, [&](std::size_t i) { return b[i] * b[i]; }));
+  A.residual(b, x, r);
+  const double target = tolerance * b_norm;
+  double r_norm2 = reproducible_sum(n, [&](std::size_t i) { return r[i] * r[i]; });
+  if (std::sqrt(r_norm2) <= target) return 0;
+  auto precondition = [&] {
+    if (preconditioner)
+      preconditioner->apply(r, z);
+    else
+      parallel_for(n, [&](std::size_t i) { z[i] = r[i]; });
+  };
+  precondition();
+  p = z;
+  double rz = reproducible_sum(n, [&](std::size_t i) { return r[i] * z[i]; });
+  int iteration = 0;
+  while (iteration < max_iterations) {
+    A.multiply(p, q);
+    const double pq = reproducible_sum(n, [&](std::size_t i) { return p[i] * q[i]; });
+    if (!(pq > 0) || !std::isfinite(pq) || !std::isfinite(rz))
+      throw std::runtime_error("conjugate gradients broke down at iteration " + std::to_string(iteration) +
+                               " (pᵀAp = " + std::to_string(pq) + "): the matrix is not positive definite");
+    const double alpha = rz / pq;
+    // x and r updated and ‖r‖² summed in one pass.
+    r_norm2 = reproducible_sum(n, [&](std::size_t i) {
+      x[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      return r[i] * r[i];
+    });
+    ++iteration;
+    if (std::sqrt(r_norm2) <= target) break;
+    precondition();
+    const double rz_new = reproducible_sum(n, [&](std::size_t i) { return r[i] * z[i]; });
+    const double beta = rz_new / rz;
+    rz = rz_new;
+    parallel_for(n, [&](std::size_t i) { p[i] = z[i] + beta * p[i]; });
+  }
+  return iteration;
+}
+
+}  // namespace frostmpm

@@ -1,0 +1,134 @@
+#include "frostmpm/linalg/multigrid_cycle.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "frostmpm/parallel/parallel.hpp"
+
+namespace frostmpm {
+
+MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators) {
+  if (operators.empty() || prolongators.size() + 1 != operators.size())
+    throw std::invalid_argument("MultigridCycle: needs one prolongator fewer than operators (got " +
+                                std::to_string(operators.size()) + " and " + std::to_string(prolongators.size()) +
+                                ")");
+  levels_.resize(operators.size());
+  for (std::size_t l = 0; l < operators.size(); ++l) {
+    Level& level = levels_[l];
+    level.A = std::move(operators[l]);
+    const std::size_t n = level.A.rows;
+    if (level.A.cols != n) throw std::invalid_argument("MultigridCycle: operator " + std::to_string(l) + " not square");
+    if (l + 1 < operators.size()) {
+      level.P = std::move(prolongators[l]);
+      if (level.P.rows != n || level.P.cols != operators[l + 1].rows)
+        throw std::invalid_argument("MultigridCycle: prolongator " + std::to_string(l) + " is " +
+                                    std::to_string(level.P.rows) + " × " + std::to_string(level.P.cols) +
+                                    ", levels have " + std::to_string(n) + " and " +
+                                    std::to_string(operators[l + 1].rows) + " rows");
+      level.R = level.P.transpose();
+    }
+    // Equal blocks, so that 2, 4 or 8 threads share the sweep evenly.
+    const std::size_t blocks = std::max<std::size_t>(1, (n + kSmootherBlockRows - 1) / kSmootherBlockRows);
+    level.block_rows = std::max<std::size_t>(1, (n + blocks - 1) / blocks);
+    // Each row's own-block columns first (a stable partition: the row's sums keep one order),
+    // and the l1-enlarged diagonal a_ii + Σ |a_ij| over the columns outside the block.
+    level.inverse_l1_diagonal.assign(n, 0.0);
+    level.in_block_end.assign(n, 0);
+    auto& A = level.A;
+    std::vector<std::pair<int, double>> outside;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t block_begin = i / level.block_rows * level.block_rows;
+      const std::size_t block_end = std::min(n, block_begin + level.block_rows);
+      double d = 0;
+      std::size_t inside = A.offsets[i];
+      outside.clear();
+      for (std::size_t k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
+        const auto j = std::size_t(A.columns[k]);
+        if (j >= block_begin && j < block_end) {
+          if (j == i) d += A.values[k];
+          A.columns[inside] = A.columns[k];
+          A.values[inside++] = A.values[k];
+        } else {
+          d += std::abs(A.values[k]);
+          outside.emplace_back(A.columns[k], A.values[k]);
+        }
+      }
+      level.in_block_end[i] = inside;
+      for (const auto& [column, value] : outside) {
+        A.columns[inside] = column;
+        A.values[inside++] = value;
+      }
+      level.inverse_l1_diagonal[i] = d != 0 ? 1.0 / d : 0.0;
+    }
+    for (auto* v : {&level.x, &level.b, &level.r, &level.previous}) v->assign(n, 0.0);
+  }
+  const Level& coarsest = levels_.back();
+  coarse_direct_ = levels_.size() > 1 && coarsest.A.rows <= kDirectCoarseRows;
+  if (coarse_direct_) {
+    const std::size_t n = coarsest.A.rows;
+    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n));
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = coarsest.A.offsets[i]; k < coarsest.A.offsets[i + 1]; ++k)
+        dense(Eigen::Index(i), coarsest.A.columns[k]) += coarsest.A.values[k];
+    coarse_.compute(dense);
+  }
+}
+
+void MultigridCycle::apply(std::span<const double> r, std::span<double> z) {
+  std::copy(r.begin(), r.end(), levels_[0].b.begin());
+  cycle(0);
+  std::copy(levels_[0].x.begin(), levels_[0].x.end(), z.begin());
+}
+
+void MultigridCycle::cycle(std::size_t l) {
+  Level& level = levels_[l];
+  const bool coarsest = l + 1 == levels_.size();
+  if (coarsest && coarse_direct_) {
+    const Eigen::Map<const Eigen::VectorXd> b(level.b.data(), Eigen::Index(level.b.size()));
+    Eigen::Map<Eigen::VectorXd>(level.x.data(), Eigen::Index(level.x.size())) = coarse_.solve(b);
+    return;
+  }
+  std::fill(level.x.begin(), level.x.end(), 0.0);
+  sweep(level, true);
+  sweep(level, false);
+  if (coarsest) return;  // a single level, or a coarsest too large to factorise: smoothing only
+  Level& coarse = levels_[l + 1];
+  level.A.residual(level.b, level.x, level.r);
+  level.R.multiply(level.r, coarse.b);
+  cycle(l + 1);
+  level.P.multiply_add(coarse.x, level.x);
+  sweep(level, true);
+  sweep(level, false);
+}
+
+void MultigridCycle::sweep(Level& level, bool forward) {
+  const std::size_t n = level.A.rows;
+  const std::size_t blocks = (n + level.block_rows - 1) / level.block_rows;
+  if (blocks > 1) std::copy(level.x.begin(), level.x.end(), level.previous.begin());
+  const auto& A = level.A;
+  double* x = level.x.data();
+  const double* previous = level.previous.data();
+  const double* b = level.b.data();
+  const double* inverse = level.inverse_l1_diagonal.data();
+  const double* values = A.values.data();
+  const int* columns = A.columns.data();
+  const std::size_t* in_block_end = level.in_block_end.data();
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (std::size_t block = 0; block < blocks; ++block) {
+    const std::size_t begin = block * level.block_rows, end = std::min(n, begin + level.block_rows);
+    auto relax = [&](std::size_t i) {
+      const double own = row_dot(values, columns, A.offsets[i], in_block_end[i], x);
+      const double others = row_dot(values, columns, in_block_end[i], A.offsets[i + 1], previous);
+      x[i] += (b[i] - own - others) * inverse[i];
+    };
+    if (forward)
+      for (std::size_t i = begin; i < end; ++i) relax(i);
+    else
+      for (std::size_t i = end; i-- > begin;) relax(i);
+  }
+}
+
+}  // namespace frostmpm
