@@ -66,7 +66,9 @@ MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<Csr
     for (auto* v : {&level.x, &level.b, &level.r, &level.previous}) v->assign(n, 0.0);
   }
   const Level& coarsest = levels_.back();
-  coarse_direct_ = levels_.size() > 1 && coarsest.A.rows <= kDirectCoarseRows;
+  // A single level small enough is solved directly too: MueLu makes no coarser level for a
+  // matrix at or below its coarse size, which its own cycle then solved exactly.
+  coarse_direct_ = coarsest.A.rows <= kDirectCoarseRows;
   if (coarse_direct_) {
     const std::size_t n = coarsest.A.rows;
     Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n));

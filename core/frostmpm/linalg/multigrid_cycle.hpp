@@ -24,7 +24,7 @@ namespace frostmpm {
 class MultigridCycle final : public LinearPreconditioner {
  public:
   static constexpr std::size_t kSmootherBlockRows = 4096;
-  /// A coarsest level above this many rows is smoothed, not factorised.
+  /// A coarsest level (or a single one) above this many rows is smoothed, not factorised.
   static constexpr std::size_t kDirectCoarseRows = 3000;
 
   /// operators[0] is the finest matrix, operators[l + 1] = Rₗ Aₗ Pₗ its coarser ones;

@@ -182,7 +182,7 @@ struct SparseSystem::Impl {
   bool tpetra_values_dirty = true;  ///< values not yet in Tpetra's matrix
   SolverOptions options;
 
-  // ---- our own threaded CG (see use_own_krylov) ----
+  // ---- our own threaded CG (why: the constructor) ----
   bool own_krylov = false;
   /// The caller's pattern (order of column_indices) with the current values: the matrix our CG
   /// iterates on, and the values every other path copies from.
@@ -211,8 +211,8 @@ struct SparseSystem::Impl {
     validate_and_sort_pattern();
     // Debian's Trilinos 13.2 builds Kokkos with its Serial back end only (KokkosCore_config.h
     // leaves KOKKOS_ENABLE_OPENMP undefined), so Belos and every Tpetra kernel run on one core
-    // whatever --threads says: in the 9 % frozen inclusion at 0.01 m the two solves were 80 %
-    // of a 2-thread run. CG with no, Jacobi or multigrid preconditioning therefore runs here,
+    // whatever --threads says: in the 9 % frozen inclusion at 0.01 m the pressure and heat solve
+    // stages were 152 s of a 166 s run on 2 threads. CG with no, Jacobi or multigrid preconditioning therefore runs here,
     // threaded with OpenMP; MueLu still builds (and refreshes) the multigrid hierarchy, which
     // is set-up work done rarely, and MultigridCycle applies it. GMRES and ILU stay with Belos
     // and Ifpack2.
