@@ -31,6 +31,7 @@
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
 #include "frostmpm/physics/kernel.hpp"
+#include "frostmpm/transfer/gradient_gram.hpp"
 #include "frostmpm/transfer/stencil_graph.hpp"
 
 namespace frostmpm::hydraulic {
@@ -167,6 +168,7 @@ class HydraulicPhysics final : public Physics {
 
   // ---- pressure system
   StencilGraph graph_;
+  GradientGram<kDim> mobility_gram_;  ///< Σ_p V_p η_p ∇S_ip·∇S_jp in graph_ (the Darcy term over Δt)
   StencilGraph compact_;  ///< coupled: the particle-stencil pattern of Q (graph_ is its square)
   std::unique_ptr<SparseSystem> system_;
   std::vector<double> values_;

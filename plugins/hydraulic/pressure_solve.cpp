@@ -28,6 +28,7 @@ void HydraulicPhysics::assemble() {
     graph_.build_scatter(st);
     compact_.build_scatter(st);
     graph_.topology_version = kernel_->transfer().topology_version();
+    mobility_gram_.invalidate();
   }
   if (!system_ || graph_.topology_version != kernel_->transfer().topology_version()) {
     if (coupled_) {
@@ -44,6 +45,7 @@ void HydraulicPhysics::assemble() {
       graph_.build(st, nodes);
     }
     graph_.topology_version = kernel_->transfer().topology_version();
+    mobility_gram_.invalidate();
     SolverOptions options;
     options.method = params_.string("solver");
     options.preconditioner = params_.string("preconditioner");
@@ -58,7 +60,13 @@ void HydraulicPhysics::assemble() {
       preconditioner_built_ = false;
     }
   }
-  values_.assign(graph_.nonzeros(), 0.0);
+  // Δt K: K kept up to date row by row (only rows near a particle whose mobility changed).
+  mobility_gram_.update(kernel_->transfer(), graph_, [&](std::size_t q) { return vol[q] * eta_[q]; });
+  const auto& mobility = mobility_gram_.values();
+  values_.resize(graph_.nonzeros());
+  parallel_for(nodes, [&](std::size_t i) {
+    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) values_[e] = dt_ * mobility[e];
+  });
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
   const int K = st.per_particle();
   const auto v_star = predicted_.values();
@@ -72,7 +80,6 @@ void HydraulicPhysics::assemble() {
     const auto* w = st.weights(q);
     const auto* g = st.gradients(q);
     const int* slot = graph_.scatter.data() + q * K * K;
-    const double k = vol[q] * dt_ * eta_[q];
     double relative[kDim];
     const double* v = v_star.data() + q * kDim;
     double skeleton_volume = 0;  // V (1 − ζ n_c) ∇·v_s*
@@ -94,12 +101,6 @@ void HydraulicPhysics::assemble() {
       for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * v[d];
       rhs_[n[a]] += flux * divergence - w[a] * source;
       if (coupled_) rhs_[n[a]] -= w[a] * skeleton_volume;
-      if (k == 0) continue;
-      for (int b = 0; b < K; ++b) {
-        double dot = 0;
-        for (int d = 0; d < kDim; ++d) dot += g[a * kDim + d] * g[b * kDim + d];
-        values_[slot[a * K + b]] += k * dot;
-      }
     }
   });
   if (coupled_) assemble_skeleton();

@@ -27,7 +27,7 @@ void ThermalPhysics::build_graph() {
   options.tolerance = params_.real("linear_tolerance");
   options.max_iterations = 5000;
   system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
-  for (auto* v : {&stiffness_, &free_stiffness_, &matrix_values_}) v->assign(graph_.nonzeros(), 0.0);
+  for (auto* v : {&free_stiffness_, &matrix_values_}) v->assign(graph_.nonzeros(), 0.0);
   for (auto* v : {&boundary_diagonal_, &boundary_load_, &residual_, &rhs_, &increment_, &K_times_T_,
                   &K_times_increment_, &start_heat_, &start_T_})
     v->assign(nodes, 0.0);
@@ -35,66 +35,28 @@ void ThermalPhysics::build_graph() {
   // or a restart, which restored them) does not change the nodes, and the next first guess
   // extrapolates from them. Zeroed, that guess would be twice the temperature.
   if (node_T_before_.size() != nodes) node_T_before_.assign(nodes, 0.0);
-  assembled_conductivity_.clear();  // a new graph is assembled in full
+  conduction_.invalidate();  // a new graph is assembled in full
 }
 
-/// K = Σ_p V_p κ_p ∇S_ip·∇S_jp, once per step (κ is fixed within it). Only the rows of nodes
-/// that see a particle whose κ changed since the last assembly are rebuilt — from every particle
-/// touching them, in the same coloured order as a full assembly, so the result is bitwise what
-/// a full assembly gives (and what a restarted run assembles). Then the copy with the rows and
-/// columns of fixed nodes (Dirichlet, empty) replaced by the identity: the Newton correction is
-/// zero there, so no right-hand side changes.
+/// K = Σ_p V_p κ_p ∇S_ip·∇S_jp, once per step (κ is fixed within it; only the rows near a
+/// particle whose κ changed are rebuilt, bitwise as a full assembly). Then the copy with the rows
+/// and columns of fixed nodes (Dirichlet, empty) replaced by the identity: the Newton correction
+/// is zero there, so no right-hand side changes.
 void ThermalPhysics::assemble_conductivity() {
-  const auto& st = kernel_->transfer().stencil();
   const auto vol = volume_.values();
-  const int K = st.per_particle();
-  const std::size_t n = st.particles();
-  if (assembled_conductivity_.size() != n) assembled_conductivity_.assign(n, std::numeric_limits<double>::quiet_NaN());
-  row_dirty_.assign(node_volume_.size(), 0);
-  bool any = false;
-  for (std::size_t p = 0; p < n; ++p)
-    if (!(conductivity_[p] == assembled_conductivity_[p])) {
-      assembled_conductivity_[p] = conductivity_[p];
-      for (int k = 0; k < K; ++k) row_dirty_[st.nodes(p)[k]] = 1;
-      any = true;
-    }
-  if (any) {
-    parallel_for(node_volume_.size(), [&](std::size_t i) {
-      if (row_dirty_[i]) std::fill(stiffness_.begin() + long(graph_.offsets[i]), stiffness_.begin() + long(graph_.offsets[i + 1]), 0.0);
-    });
-    kernel_->transfer().scatter([&](std::size_t p) {
-      const auto* nodes = st.nodes(p);
-      bool touches = false;
-      for (int k = 0; k < K; ++k) touches |= row_dirty_[nodes[k]] != 0;
-      if (!touches) return;
-      const auto* g = st.gradients(p);
-      const int* slot = graph_.scatter.data() + p * K * K;
-      const double a = vol[p] * conductivity_[p];
-      for (int i = 0; i < K; ++i) {
-        if (!row_dirty_[nodes[i]]) continue;
-        for (int j = 0; j < K; ++j) {
-          double dot = 0;
-          for (int d = 0; d < kDim; ++d) dot += g[i * kDim + d] * g[j * kDim + d];
-          stiffness_[slot[i * K + j]] += a * dot;
-        }
-      }
-    });
-  }
+  conduction_.update(kernel_->transfer(), graph_, [&](std::size_t p) { return vol[p] * conductivity_[p]; });
+  const auto& stiffness = conduction_.values();
   parallel_for(node_volume_.size(), [&](std::size_t i) {
     const bool fixed_row = !is_free(i);
     for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) {
       const auto j = static_cast<std::size_t>(graph_.columns[e]);
-      free_stiffness_[e] = fixed_row ? (i == j ? 1.0 : 0.0) : is_free(j) ? stiffness_[e] : 0.0;
+      free_stiffness_[e] = fixed_row ? (i == j ? 1.0 : 0.0) : is_free(j) ? stiffness[e] : 0.0;
     }
   });
 }
 
 void ThermalPhysics::multiply_conductivity(const std::vector<double>& x, std::vector<double>& y) const {
-  parallel_for(y.size(), [&](std::size_t i) {
-    double s = 0;
-    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) s += stiffness_[e] * x[static_cast<std::size_t>(graph_.columns[e])];
-    y[i] = s;
-  });
+  conduction_.multiply(graph_, x, y);
 }
 
 /// R(T) into residual_ (zero at fixed nodes) and K T into K_times_T_; returns the largest
@@ -227,13 +189,7 @@ bool ThermalPhysics::newton(double t_end, double h) {
 }
 
 void ThermalPhysics::solve_implicit() {
-  const auto& st = kernel_->transfer().stencil();
   if (!system_ || kernel_->transfer().topology_version() != graph_.topology_version) build_graph();
-  // Particles moved: every weight changed, so the next assembly is a full one.
-  if (assembled_version_ != st.version()) {
-    assembled_conductivity_.clear();
-    assembled_version_ = st.version();
-  }
   assemble_conductivity();
   preconditioner_fresh_ = false;  // the tangent's off-diagonal part changed with κ
   // The convective term is lagged (the temperatures and flux of the step's start): a source for

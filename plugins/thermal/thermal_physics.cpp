@@ -281,7 +281,6 @@ void ThermalPhysics::removing_particles(const ParticleRemoval& removal) {
   removal.compact(conductivity_);
   removal.compact(energy_);
   removal.compact(hint_);
-  removal.compact(assembled_conductivity_);
   for (auto& c : particle_T_) removal.remap(c.particles);
   for (auto& s : particle_surfaces_) removal.remap(s.particles);
   surfaces_version_ = ~std::uint64_t{0};

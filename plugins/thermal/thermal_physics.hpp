@@ -29,6 +29,7 @@
 #include "frostmpm/physics/physics.hpp"
 #include "frostmpm/scene/time_function.hpp"
 #include "frostmpm/physics/kernel.hpp"
+#include "frostmpm/transfer/gradient_gram.hpp"
 #include "frostmpm/transfer/stencil_graph.hpp"
 #include "mixture_properties.hpp"
 #include "nodal_heat.hpp"
@@ -140,12 +141,10 @@ class ThermalPhysics final : public Physics {
   // ---- implicit --------------------------------------------------------------------------------
   std::unique_ptr<SparseSystem> system_;
   StencilGraph graph_;  ///< CSR pattern of the conductivity matrix
-  std::vector<double> stiffness_, free_stiffness_, matrix_values_;
+  GradientGram<kDim> conduction_;  ///< K = Σ_p V_p κ_p ∇S_ip·∇S_jp
+  std::vector<double> free_stiffness_, matrix_values_;
   std::vector<double> boundary_diagonal_, boundary_load_;  ///< h A_i and q A_i + h A_i T_a
   std::vector<double> residual_, rhs_, increment_, K_times_T_, K_times_increment_, start_heat_, start_T_;
-  std::vector<double> assembled_conductivity_;  ///< κ_p as in stiffness_
-  std::uint64_t assembled_version_ = 0;        ///< the stencil stiffness_ was assembled on
-  std::vector<char> row_dirty_;
   long halvings_ = 0;  ///< the last step's substep level (the next step starts one coarser)
   std::vector<double> node_T_before_;  ///< nodal T at the start of the last accepted substep
   double previous_substep_ = 0;       ///< its length (0: no history, e.g. after a re-projection)

@@ -172,9 +172,13 @@ CsrMatrix to_csr(const Matrix& M, const Map& rows, const Map& columns) {
 
 struct SparseSystem::Impl {
   // ---- pattern and values (host copy, order of the caller's column_indices) ----
+  /// The caller's pattern (order of column_indices) with the current values: the matrix our CG
+  /// iterates on, and the values every other path copies from. It holds the pattern once;
+  /// offsets and columns name its parts.
+  CsrMatrix current;
   std::size_t n = 0;
-  std::vector<std::size_t> offsets;
-  std::vector<int> columns;         ///< as given
+  std::vector<std::size_t>& offsets = current.offsets;
+  std::vector<int>& columns = current.columns;  ///< as given
   std::vector<LO> sorted_columns;   ///< per row, ascending
   std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
   std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
@@ -184,9 +188,6 @@ struct SparseSystem::Impl {
 
   // ---- our own threaded CG (why: the constructor) ----
   bool own_krylov = false;
-  /// The caller's pattern (order of column_indices) with the current values: the matrix our CG
-  /// iterates on, and the values every other path copies from.
-  CsrMatrix current;
   std::unique_ptr<LinearPreconditioner> own_preconditioner;
 
   // ---- Trilinos objects (absent when n == 0) ----
@@ -205,8 +206,9 @@ struct SparseSystem::Impl {
   PreconditionerSource source;  ///< the values it was built and refreshed from
 
   Impl(std::vector<std::size_t> row_offsets, std::vector<int> column_indices, SolverOptions opts)
-      : offsets(std::move(row_offsets)), columns(std::move(column_indices)),
-        options(std::move(opts)) {
+      : options(std::move(opts)) {
+    offsets = std::move(row_offsets);
+    columns = std::move(column_indices);
     validate_options(options);
     validate_and_sort_pattern();
     // Debian's Trilinos 13.2 builds Kokkos with its Serial back end only (KokkosCore_config.h
@@ -218,8 +220,6 @@ struct SparseSystem::Impl {
     // and Ifpack2.
     own_krylov = options.method == "cg" && options.preconditioner != "ilu";
     current.rows = current.cols = n;
-    current.offsets = offsets;
-    current.columns = columns;
     current.values.assign(columns.size(), 0.0);
     if (n > 0) build_trilinos_objects();
   }
