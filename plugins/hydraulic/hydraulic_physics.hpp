@@ -155,6 +155,7 @@ class HydraulicPhysics final : public Physics {
   // liquid mass (a node no wet particle touches has none and no pressure unknown)
   std::vector<double>*p_ = nullptr, *dp_ = nullptr;
   std::vector<double> node_mass_, rhs_;
+  std::vector<double> node_storage_;  ///< Σ_p S_ip V_p n_l c_w / Δt, the lumped storage of this step
   // Polynomial pressure projection (Eqs. 66–67): per grid cell, ∫ τ/(2G) over its material
   std::vector<double> cell_stabilization_;
   std::uint64_t stabilization_version_ = ~std::uint64_t{0};  ///< stencil the cell weights belong to (none yet)

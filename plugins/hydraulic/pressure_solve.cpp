@@ -60,14 +60,8 @@ void HydraulicPhysics::assemble() {
       preconditioner_built_ = false;
     }
   }
-  // Δt K: K kept up to date row by row (only rows near a particle whose mobility changed).
-  mobility_gram_.update(kernel_->transfer(), graph_, [&](std::size_t q) { return vol[q] * eta_[q]; });
-  const auto& mobility = mobility_gram_.values();
-  values_.resize(graph_.nonzeros());
-  parallel_for(nodes, [&](std::size_t i) {
-    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) values_[e] = dt_ * mobility[e];
-  });
   std::fill(rhs_.begin(), rhs_.end(), 0.0);
+  node_storage_.assign(nodes, 0.0);
   const int K = st.per_particle();
   const auto v_star = predicted_.values();
   // A moving skeleton: the relative flux n_l (v_l* − v_s*) crosses the test functions' gradients
@@ -79,7 +73,6 @@ void HydraulicPhysics::assemble() {
     const auto* n = st.nodes(q);
     const auto* w = st.weights(q);
     const auto* g = st.gradients(q);
-    const int* slot = graph_.scatter.data() + q * K * K;
     double relative[kDim];
     const double* v = v_star.data() + q * kDim;
     double skeleton_volume = 0;  // V (1 − ζ n_c) ∇·v_s*
@@ -96,12 +89,20 @@ void HydraulicPhysics::assemble() {
     }
     const double flux = vol[q] * n_l_[q], storage = vol[q] * storage_[q] / dt_, source = vol[q] * source_[q];
     for (int a = 0; a < K; ++a) {
-      values_[slot[a * K + a]] += w[a] * storage;  // M lumped on the diagonal
+      node_storage_[n[a]] += w[a] * storage;  // M lumped (onto the diagonal below)
       double divergence = 0;
       for (int d = 0; d < kDim; ++d) divergence += g[a * kDim + d] * v[d];
       rhs_[n[a]] += flux * divergence - w[a] * source;
       if (coupled_) rhs_[n[a]] -= w[a] * skeleton_volume;
     }
+  });
+  // Δt K + M/Δt: K kept up to date row by row (only rows near a particle whose mobility changed).
+  mobility_gram_.update(kernel_->transfer(), graph_, [&](std::size_t q) { return vol[q] * eta_[q]; });
+  const auto& mobility = mobility_gram_.values();
+  values_.resize(graph_.nonzeros());
+  parallel_for(nodes, [&](std::size_t i) {
+    for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) values_[e] = dt_ * mobility[e];
+    values_[graph_.diagonal[i]] += node_storage_[i];
   });
   if (coupled_) assemble_skeleton();
   if (stabilized_) add_stabilization();

@@ -95,14 +95,17 @@ void MultigridCycle::cycle(std::size_t l) {
   }
   std::fill(level.x.begin(), level.x.end(), 0.0);
   sweep(level, true);
-  sweep(level, false);
-  if (coarsest) return;  // a single level, or a coarsest too large to factorise: smoothing only
+  if (coarsest) {  // a single level, or a coarsest too large to factorise: smoothing only
+    sweep(level, false);
+    return;
+  }
   Level& coarse = levels_[l + 1];
   level.A.residual(level.b, level.x, level.r);
   level.R.multiply(level.r, coarse.b);
   cycle(l + 1);
   level.P.multiply_add(coarse.x, level.x);
-  sweep(level, true);
+  // One sweep each side, not two: four passes over the finest matrix per CG iteration instead
+  // of six, for 25 % more iterations (9 % frozen inclusion at 0.02 m: 10.6 -> 13.2 a step).
   sweep(level, false);
 }
 

@@ -8,8 +8,9 @@
 // and each row's diagonal enlarged by the sum of |a_ij| over columns outside its block, which
 // keeps the smoother convergent for any symmetric positive definite A however it is blocked.
 // The blocks depend on the row count only, so the cycle is bitwise the same on any thread
-// count. One forward and one backward sweep before and after the coarse correction keep the
-// cycle symmetric, as CG needs. The coarsest level is solved exactly (dense LDLᵀ).
+// count. A forward sweep before the coarse correction and a backward one after it (V(1,1)) keep
+// the cycle symmetric, as CG needs: the backward sweep's splitting is the transpose of the
+// forward one's. The coarsest level is solved exactly (dense LDLᵀ).
 #include <cstddef>
 #include <span>
 #include <vector>
