@@ -1,5 +1,6 @@
 #include "frostmpm/linalg/conjugate_gradient.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -18,10 +19,19 @@ void JacobiPreconditioner::apply(std::span<const double> r, std::span<double> z)
 
 int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner, std::span<const double> b,
                        std::span<double> x, double tolerance, int max_iterations) {
-  const std::size_t n = A.rows;
-  std::vector<double> r(n), z(n), p(n), q(n);
-  const double b_norm = std::sqrt(reproducible_sum(n, [&](std::size_t i) { return b[i] * b[i]; }));
+  std::vector<double> r(A.rows);
   A.residual(b, x, r);
+  ConjugateGradientWork work;
+  return conjugate_gradient(A, preconditioner, b, x, r, tolerance, max_iterations, work);
+}
+
+int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner, std::span<const double> b,
+                       std::span<double> x, std::span<double> r, double tolerance, int max_iterations,
+                       ConjugateGradientWork& work) {
+  const std::size_t n = A.rows;
+  for (auto* v : {&work.z, &work.p, &work.q}) v->resize(n);
+  auto &z = work.z, &p = work.p, &q = work.q;
+  const double b_norm = std::sqrt(reproducible_sum(n, [&](std::size_t i) { return b[i] * b[i]; }));
   const double target = tolerance * b_norm;
   double r_norm2 = reproducible_sum(n, [&](std::size_t i) { return r[i] * r[i]; });
   if (std::sqrt(r_norm2) <= target) return 0;
@@ -32,7 +42,7 @@ int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner,
       parallel_for(n, [&](std::size_t i) { z[i] = r[i]; });
   };
   precondition();
-  p = z;
+  std::copy(z.begin(), z.end(), p.begin());
   double rz = reproducible_sum(n, [&](std::size_t i) { return r[i] * z[i]; });
   int iteration = 0;
   while (iteration < max_iterations) {

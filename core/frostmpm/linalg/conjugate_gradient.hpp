@@ -33,4 +33,14 @@ class JacobiPreconditioner final : public LinearPreconditioner {
 int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner, std::span<const double> b,
                        std::span<double> x, double tolerance, int max_iterations);
 
+/// CG's vectors besides x and r, kept by a caller that solves many times (no allocation a solve).
+struct ConjugateGradientWork {
+  std::vector<double> z, p, q;
+};
+/// The same, with r = b − A x given on entry (a caller that has just measured the true residual
+/// spends no product on it); r holds the updated residual on return.
+int conjugate_gradient(const CsrMatrix& A, LinearPreconditioner* preconditioner, std::span<const double> b,
+                       std::span<double> x, std::span<double> r, double tolerance, int max_iterations,
+                       ConjugateGradientWork& work);
+
 }  // namespace frostmpm

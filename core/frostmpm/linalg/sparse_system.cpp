@@ -189,6 +189,10 @@ struct SparseSystem::Impl {
   // ---- our own threaded CG (why: the constructor) ----
   bool own_krylov = false;
   std::unique_ptr<LinearPreconditioner> own_preconditioner;
+  struct {
+    std::vector<double> residual;
+    ConjugateGradientWork cg;
+  } own_work;  ///< kept between solves
 
   // ---- Trilinos objects (absent when n == 0) ----
   RCP<const Teuchos::Comm<int>> comm;
@@ -553,7 +557,8 @@ struct SparseSystem::Impl {
   /// Krylov passes (`krylov(iterations left)` returns the iterations it took) from the current x
   /// until the true relative residual (`residual()`) meets the tolerance: a Krylov method judges
   /// convergence on its recursively updated residual, which rounding can leave below the true
-  /// one. At most four passes, and none once an iteration budget is spent or a pass stalls.
+  /// one. At most four passes, and none once an iteration budget is spent or a pass stalls. Each
+  /// pass starts from the x that residual() was last called at (our CG takes that residual over).
   template <class Krylov, class Residual>
   void iterate_to_tolerance(SolveStats& stats, double tolerance, Krylov&& krylov, Residual&& residual) const {
     double rel = residual();
@@ -581,7 +586,8 @@ struct SparseSystem::Impl {
       return stats;
     }
     if (!std::isfinite(b_norm)) throw std::invalid_argument("SparseSystem::solve: rhs contains inf or NaN");
-    std::vector<double> residual(n);
+    auto& residual = own_work.residual;
+    residual.resize(n);
     auto true_residual = [&] {
       current.residual(rhs, x_io, residual);
       return std::sqrt(reproducible_sum(n, [&](std::size_t i) { return residual[i] * residual[i]; })) / b_norm;
@@ -589,8 +595,9 @@ struct SparseSystem::Impl {
     iterate_to_tolerance(
         stats, tolerance,
         [&](int remaining) {
-          try {
-            return conjugate_gradient(current, own_preconditioner.get(), rhs, x_io, tolerance, remaining);
+          try {  // from the true residual just measured for this x
+            return conjugate_gradient(current, own_preconditioner.get(), rhs, x_io, residual, tolerance, remaining,
+                                      own_work.cg);
           } catch (const std::exception& e) {
             throw std::runtime_error(std::string("SparseSystem: cg solve failed: ") + e.what());
           }
