@@ -183,7 +183,6 @@ struct SparseSystem::Impl {
   std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
   std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
   bool values_dirty = true;         ///< values changed since the last solve
-  bool tpetra_values_dirty = true;  ///< values not yet in Tpetra's matrix
   SolverOptions options;
 
   // ---- our own threaded CG (why: the constructor) ----
@@ -322,23 +321,23 @@ struct SparseSystem::Impl {
     }
   }
 
-  /// Copies the host values into the Tpetra matrix (graph unchanged): one pass over the value
-  /// array instead of per-row index searches.
-  void upload_values() {
-    if (matrix->isFillComplete()) matrix->resumeFill();
+  /// Copies the host values into a Tpetra matrix on the system's graph (`matrix` or
+  /// `preconditioner_matrix`): one pass over the value array instead of per-row index searches.
+  void upload_values(Matrix& target) {
+    if (target.isFillComplete()) target.resumeFill();
     {
-      const auto device_values = matrix->getLocalValuesView();
+      const auto device_values = target.getLocalValuesView();
       const auto host_values = Kokkos::create_mirror_view(device_values);
       for (std::size_t k = 0; k < current.values.size(); ++k) host_values(storage_position[k]) = current.values[k];
       Kokkos::deep_copy(device_values, host_values);
     }
-    matrix->fillComplete();
-    tpetra_values_dirty = false;
+    target.fillComplete();
   }
 
-  /// The caller's values into the matrix the solver iterates on (ours iterates on `current`).
+  /// The caller's values into the matrix the solver iterates on (ours iterates on `current`,
+  /// and Tpetra's `matrix` stays unused).
   void take_values() {
-    if (!own_krylov) upload_values();
+    if (!own_krylov) upload_values(*matrix);
     values_dirty = false;
   }
 
@@ -388,8 +387,7 @@ struct SparseSystem::Impl {
       own_preconditioner = std::make_unique<JacobiPreconditioner>(current);
       record_source(refresh);
     } else if (kind == "multigrid") {
-      if (tpetra_values_dirty) upload_values();
-      copy_values_to_preconditioner_matrix();
+      upload_values(*preconditioner_matrix);  // MueLu's input, straight from `current`
       build_muelu(refresh);
       own_preconditioner = std::make_unique<MultigridCycle>(extract_hierarchy());
     }
@@ -607,7 +605,7 @@ struct SparseSystem::Impl {
     return stats;
   }
 
-  void mark_values_changed() { values_dirty = tpetra_values_dirty = true; }
+  void mark_values_changed() { values_dirty = true; }
 
   void add_to_entry(std::size_t row, std::size_t col, double delta) {
     if (row >= n || col >= n) {
