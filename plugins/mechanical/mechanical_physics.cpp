@@ -40,7 +40,8 @@ void for_support(int K, F&& f) {
 /// as the generic update keeps them in 2-D, and L finite (a non-finite L gives NaNs whose
 /// placement the generic code decides); otherwise it returns false without writing anything,
 /// and the generic code runs. F is row-major 3×3, the stresses 6 Voigt values.
-bool plane_strain_kinematics(const std::array<std::array<double, 2>, 2>& L, double dt, double* F, double* de,
+[[gnu::always_inline]] inline bool plane_strain_kinematics(const std::array<std::array<double, 2>, 2>& L, double dt,
+                                                           double* F, double* de,
                              double& J_ratio, bool jaumann, const double* start, double* rotated) {
   constexpr auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
   constexpr std::uint64_t kMinusZero = std::uint64_t{1} << 63;
@@ -335,7 +336,7 @@ typename MechanicalPhysics<Dim>::DensityView MechanicalPhysics<Dim>::density_vie
 }
 
 template <int Dim>
-inline void MechanicalPhysics<Dim>::DensityView::operator()(std::size_t p, double& rho_m, double& skeleton,
+[[gnu::always_inline]] inline void MechanicalPhysics<Dim>::DensityView::operator()(std::size_t p, double& rho_m, double& skeleton,
                                                             double& n_l) const {
   const auto& m = materials[material[p]];
   const double phi = porosity[p];
@@ -497,7 +498,8 @@ void MechanicalPhysics<Dim>::map_to_grid() {
       }
       for (int k = 0; k < K; ++k) {
         mass[nodes[k]] += m_k[k];
-        if (w[k] > 0) inertia_floor[nodes[k]] = std::max(inertia_floor[nodes[k]], mu * m);
+        // Branch-free: whether a weight is zero follows the particle's place in its cell.
+        inertia_floor[nodes[k]] = std::max(inertia_floor[nodes[k]], w[k] > 0 ? mu * m : 0.0);
         for (int d = 0; d < Dim; ++d) momentum[nodes[k] * Dim + d] += p_k[k * Dim + d];
       }
     });
