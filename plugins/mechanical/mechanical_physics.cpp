@@ -41,8 +41,8 @@ void for_support(int K, F&& f) {
 /// placement the generic code decides); otherwise it returns false without writing anything,
 /// and the generic code runs. F is row-major 3×3, the stresses 6 Voigt values.
 [[gnu::always_inline]] inline bool plane_strain_kinematics(const std::array<std::array<double, 2>, 2>& L, double dt,
-                                                           double* F, double* de,
-                             double& J_ratio, bool jaumann, const double* start, double* rotated) {
+                                                           double* F, double* de, double& J_ratio, bool jaumann,
+                                                           const double* start, double* rotated) {
   constexpr auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
   constexpr std::uint64_t kMinusZero = std::uint64_t{1} << 63;
   if (bits(F[2]) != 0 || bits(F[5]) != 0 || bits(F[6]) != 0 || bits(F[7]) != 0 || F[8] != 1.0) return false;
@@ -336,8 +336,9 @@ typename MechanicalPhysics<Dim>::DensityView MechanicalPhysics<Dim>::density_vie
 }
 
 template <int Dim>
-[[gnu::always_inline]] inline void MechanicalPhysics<Dim>::DensityView::operator()(std::size_t p, double& rho_m, double& skeleton,
-                                                            double& n_l) const {
+[[gnu::always_inline]] inline void MechanicalPhysics<Dim>::DensityView::operator()(std::size_t p, double& rho_m,
+                                                                                   double& skeleton,
+                                                                                   double& n_l) const {
   const auto& m = materials[material[p]];
   const double phi = porosity[p];
   const double S = saturation ? std::clamp(saturation[p], 0.0, 1.0) : 1.0;
