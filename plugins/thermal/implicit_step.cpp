@@ -26,8 +26,9 @@ void ThermalPhysics::build_graph() {
   options.preconditioner = params_.string("preconditioner");
   options.tolerance = params_.real("linear_tolerance");
   options.max_iterations = 5000;
+  options.restorable_preconditioner = false;  // each step builds its own (newton())
   system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
-  for (auto* v : {&free_stiffness_, &matrix_values_}) v->assign(graph_.nonzeros(), 0.0);
+  free_stiffness_.assign(graph_.nonzeros(), 0.0);
   for (auto* v : {&boundary_diagonal_, &boundary_load_, &residual_, &rhs_, &increment_, &K_times_T_,
                   &K_times_increment_, &start_heat_, &start_T_})
     v->assign(nodes, 0.0);
@@ -156,14 +157,15 @@ bool ThermalPhysics::newton(double t_end, double h) {
     if (!std::isfinite(worst)) report_not_finite(t_end, h);
     if (it > 1) forcing = std::clamp(0.9 * std::pow(worst / previous_worst, 2.0), linear_floor, 1e-2);
     previous_worst = worst;
-    matrix_values_ = free_stiffness_;
+    // The tangent K + C/h, written straight into the system's values.
+    const auto tangent = system_->mutable_values();
+    std::copy(free_stiffness_.begin(), free_stiffness_.end(), tangent.begin());
     parallel_for((*node_T_).size(), [&](std::size_t i) {
       rhs_[i] = -residual_[i];
       increment_[i] = 0.0;
       if (is_free(i))
-        matrix_values_[graph_.diagonal[i]] += node_volume_[i] * nodal_.capacity(i, (*node_T_)[i]) / h + boundary_diagonal_[i];
+        tangent[graph_.diagonal[i]] += node_volume_[i] * nodal_.capacity(i, (*node_T_)[i]) / h + boundary_diagonal_[i];
     });
-    system_->set_values(matrix_values_);
     // The preconditioner is built once per step, from the step's first tangent, and reused by the
     // later iterations (a private copy of the values keeps it a fixed SPD operator); Jacobi costs
     // nothing to refresh. A fixed policy keeps restarts bitwise.

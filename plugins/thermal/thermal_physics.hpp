@@ -142,7 +142,7 @@ class ThermalPhysics final : public Physics {
   std::unique_ptr<SparseSystem> system_;
   StencilGraph graph_;  ///< CSR pattern of the conductivity matrix
   GradientGram<kDim> conduction_;  ///< K = Σ_p V_p κ_p ∇S_ip·∇S_jp
-  std::vector<double> free_stiffness_, matrix_values_;
+  std::vector<double> free_stiffness_;
   std::vector<double> boundary_diagonal_, boundary_load_;  ///< h A_i and q A_i + h A_i T_a
   std::vector<double> residual_, rhs_, increment_, K_times_T_, K_times_increment_, start_heat_, start_T_;
   long halvings_ = 0;  ///< the last step's substep level (the next step starts one coarser)

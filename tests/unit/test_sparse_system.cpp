@@ -266,6 +266,26 @@ TEST_CASE("SparseSystem refills values on the same graph and reuses the precondi
     REQUIRE_THROWS_AS(restored.restore_preconditioner(wrong), std::invalid_argument);
   }
 
+  SECTION("values written in place solve as set_values' do; a preconditioner not kept restorable has no source") {
+    SolverOptions options = make_options(method, preconditioner);
+    options.restorable_preconditioner = false;
+    SparseSystem quiet(grid.offsets, grid.columns, options);
+    const auto values = grid.values(0.5);
+    const auto in_place = quiet.mutable_values();
+    std::copy(values.begin(), values.end(), in_place.begin());
+    system.set_values(values);
+    const auto b = multiply(grid.offsets, grid.columns, values, x_exact);
+    std::vector<double> x_quiet(grid.n(), 0.0), x(grid.n(), 0.0);
+    for (const auto update : {PreconditionerUpdate::Rebuild, PreconditionerUpdate::Refresh}) {
+      REQUIRE(quiet.solve(b, x_quiet, update).converged);
+      REQUIRE(system.solve(b, x, update).converged);
+      REQUIRE(x_quiet == x);
+      REQUIRE(quiet.preconditioner_source().built.empty());
+      REQUIRE(quiet.preconditioner_source().refreshed.empty());
+      REQUIRE_FALSE(system.preconditioner_source().built.empty());
+    }
+  }
+
   SECTION("add_to_entry rejects entries outside the pattern") {
     REQUIRE_THROWS_AS(system.add_to_entry(0, 2, 1.0), std::out_of_range);
     REQUIRE_THROWS_AS(system.add_to_entry(0, 900, 1.0), std::out_of_range);

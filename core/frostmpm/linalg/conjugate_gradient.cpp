@@ -13,6 +13,15 @@ JacobiPreconditioner::JacobiPreconditioner(const CsrMatrix& A) : inverse_diagona
   for (double& d : inverse_diagonal_) d = d != 0 ? 1.0 / d : 1.0;
 }
 
+JacobiPreconditioner::JacobiPreconditioner(std::span<const double> values,
+                                           std::span<const std::size_t> diagonal_position)
+    : inverse_diagonal_(diagonal_position.size()) {
+  parallel_for(diagonal_position.size(), [&](std::size_t i) {
+    const double d = diagonal_position[i] == no_entry ? 0.0 : values[diagonal_position[i]];
+    inverse_diagonal_[i] = d != 0 ? 1.0 / d : 1.0;
+  });
+}
+
 void JacobiPreconditioner::apply(std::span<const double> r, std::span<double> z) {
   parallel_for(r.size(), [&](std::size_t i) { z[i] = inverse_diagonal_[i] * r[i]; });
 }

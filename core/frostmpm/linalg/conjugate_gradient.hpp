@@ -2,6 +2,7 @@
 // Preconditioned conjugate gradients on a CsrMatrix, threaded with OpenMP: products by rows,
 // dot products in fixed chunks (reproducible_sum), so the iterates are bitwise the same on any
 // thread count. sparse_system.cpp says why this exists beside Belos.
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -19,7 +20,10 @@ class LinearPreconditioner {
 /// z = D⁻¹ r (rows whose diagonal is zero pass r through).
 class JacobiPreconditioner final : public LinearPreconditioner {
  public:
+  static constexpr std::size_t no_entry = std::size_t(-1);
   explicit JacobiPreconditioner(const CsrMatrix& A);
+  /// a_ii = values[diagonal_position[i]] (no_entry: none), without scanning the rows.
+  JacobiPreconditioner(std::span<const double> values, std::span<const std::size_t> diagonal_position);
   void apply(std::span<const double> r, std::span<double> z) override;
 
  private:

@@ -54,6 +54,7 @@
 #include "frostmpm/linalg/conjugate_gradient.hpp"
 #include "frostmpm/linalg/csr_matrix.hpp"
 #include "frostmpm/linalg/mpi_session.hpp"
+#include "frostmpm/linalg/galerkin_product.hpp"
 #include "frostmpm/linalg/multigrid_cycle.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 
@@ -182,12 +183,15 @@ struct SparseSystem::Impl {
   std::vector<LO> sorted_columns;   ///< per row, ascending
   std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
   std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
+  std::vector<std::size_t> diagonal_position;  ///< row -> its diagonal entry's index, or no_entry
   bool values_dirty = true;         ///< values changed since the last solve
   SolverOptions options;
 
   // ---- our own threaded CG (why: the constructor) ----
   bool own_krylov = false;
   std::unique_ptr<LinearPreconditioner> own_preconditioner;
+  /// Multigrid: the build's prolongators and the patterns of their coarse operators, finest first.
+  std::vector<GalerkinProduct> galerkin;
   struct {
     std::vector<double> residual;
     ConjugateGradientWork cg;
@@ -251,6 +255,7 @@ struct SparseSystem::Impl {
     }
     order.resize(columns.size());
     sorted_columns.resize(columns.size());
+    diagonal_position.assign(n, JacobiPreconditioner::no_entry);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t begin = offsets[i], end = offsets[i + 1];
       for (std::size_t k = begin; k < end; ++k) {
@@ -265,6 +270,7 @@ struct SparseSystem::Impl {
                 [&](std::size_t a, std::size_t c) { return columns[a] < columns[c]; });
       for (std::size_t k = begin; k < end; ++k) {
         sorted_columns[k] = columns[order[k]];
+        if (std::size_t(sorted_columns[k]) == i) diagonal_position[i] = order[k];
         if (k > begin && sorted_columns[k] == sorted_columns[k - 1]) {
           throw std::invalid_argument("SparseSystem: column " + std::to_string(sorted_columns[k]) +
                                       " appears twice in row " + std::to_string(i));
@@ -384,20 +390,37 @@ struct SparseSystem::Impl {
   void build_own_preconditioner(bool refresh) {
     const auto& kind = options.preconditioner;
     if (kind == "jacobi") {
-      own_preconditioner = std::make_unique<JacobiPreconditioner>(current);
+      own_preconditioner = std::make_unique<JacobiPreconditioner>(current.values, diagonal_position);
       record_source(refresh);
     } else if (kind == "multigrid") {
-      upload_values(*preconditioner_matrix);  // MueLu's input, straight from `current`
-      build_muelu(refresh);
-      own_preconditioner = std::make_unique<MultigridCycle>(extract_hierarchy());
+      std::vector<CsrMatrix> operators{current}, prolongators;
+      if (refresh && !muelu.is_null()) {
+        // New values on the build's prolongators (what MueLu's "RP" reuse keeps), the coarse
+        // operators Pᵀ A P by our own threaded product: MueLu's serial one cost about two CG
+        // iterations a refresh (9 % frozen inclusion at 0.01 m).
+        for (const auto& product : galerkin) {
+          operators.push_back(product(operators.back()));
+          prolongators.push_back(product.prolongator());
+        }
+        record_source(true);
+      } else {
+        upload_values(*preconditioner_matrix);  // MueLu's input, straight from `current`
+        build_muelu(false);
+        extract_hierarchy(operators, prolongators);
+        galerkin.clear();
+        galerkin.reserve(prolongators.size());  // `pattern` points into it
+        const CsrMatrix* pattern = &current;
+        for (const auto& P : prolongators) pattern = &galerkin.emplace_back(*pattern, P).coarse_pattern();
+      }
+      own_preconditioner = std::make_unique<MultigridCycle>(std::move(operators), std::move(prolongators));
     }
     have_preconditioner = true;
   }
 
-  /// MueLu's levels as CSR: the finest is `current` (the values just given to MueLu).
-  MultigridCycle extract_hierarchy() const {
+  /// MueLu's coarse levels as CSR, appended to operators (whose first, the finest, is `current`:
+  /// the values just given to MueLu) and prolongators.
+  void extract_hierarchy(std::vector<CsrMatrix>& operators, std::vector<CsrMatrix>& prolongators) const {
     const auto hierarchy = muelu->GetHierarchy();
-    std::vector<CsrMatrix> operators{current}, prolongators;
     RCP<const Map> fine_rows = map;  // level 0: our rows 0 … n − 1 in order
     for (int l = 1; l < hierarchy->GetNumLevels(); ++l) {
       const auto level = hierarchy->GetLevel(l);
@@ -407,10 +430,10 @@ struct SparseSystem::Impl {
       prolongators.push_back(to_csr(*P, *fine_rows, *A->getRowMap()));
       fine_rows = A->getRowMap();
     }
-    return MultigridCycle(std::move(operators), std::move(prolongators));
   }
 
   void record_source(bool refreshed) {
+    if (!options.restorable_preconditioner) return;
     if (refreshed)
       source.refreshed = current.values;
     else
@@ -649,6 +672,11 @@ void SparseSystem::set_values(std::span<const double> values) {
 }
 
 std::span<const double> SparseSystem::values() const { return impl_->current.values; }
+
+std::span<double> SparseSystem::mutable_values() {
+  impl_->mark_values_changed();
+  return impl_->current.values;
+}
 
 void SparseSystem::add_to_entry(std::size_t row, std::size_t col, double delta) {
   impl_->add_to_entry(row, col, delta);

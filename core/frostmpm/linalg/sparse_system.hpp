@@ -23,6 +23,10 @@ struct SolverOptions {
   double tolerance = 1e-10;               ///< on the true relative residual ||b - A x|| / ||b||
   int max_iterations = 1000;              ///< total Krylov iterations per solve()
   int gmres_restart = 100;                ///< Krylov basis size before GMRES restarts
+  /// Keep the values each preconditioner was built and refreshed from (preconditioner_source(),
+  /// for checkpoints): a copy of the matrix per build or refresh. A caller that builds its
+  /// preconditioner anew after a restart anyway turns it off.
+  bool restorable_preconditioner = true;
 };
 
 struct SolveStats {
@@ -86,6 +90,8 @@ class SparseSystem {
   void set_values(std::span<const double> values);
   /// Current values, in the order of column_indices.
   std::span<const double> values() const;
+  /// The values to write in place (no copy, unlike set_values); counts as a change of them.
+  std::span<double> mutable_values();
   /// A(row, col) += delta for an entry of the pattern; throws std::out_of_range for an entry
   /// outside the pattern. O(log(entries in row)).
   void add_to_entry(std::size_t row, std::size_t col, double delta);
@@ -104,7 +110,8 @@ class SparseSystem {
   SolveStats solve(std::span<const double> rhs, std::span<double> x, PreconditionerUpdate update,
                    double tolerance = 0.0);
 
-  /// What the current preconditioner was made from (both empty when there is none).
+  /// What the current preconditioner was made from (both empty when there is none, or when
+  /// options().restorable_preconditioner is off).
   PreconditionerSource preconditioner_source() const;
   /// Builds the preconditioner from source.built and refreshes it from source.refreshed (if
   /// given), as the solves that made it did; the system's current values stay as they are. An
