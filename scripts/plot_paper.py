@@ -12,6 +12,7 @@
     /usr/bin/python3 scripts/plot_paper.py footing OUT_unthawed OUT_thawing OUT_prethawed [...] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py slump OUT [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py planar_slump OUT [OUT ...] [--png FILE] [--frame N]
+    /usr/bin/python3 scripts/plot_paper.py planar_onset OUT_h1 OUT_h2 [OUT_h3 ...] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py footing_rates OUT_2 OUT_1 OUT_0.5 OUT_0.25 [--png FILE]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
@@ -40,7 +41,11 @@ deviatoric strain and displacement, each with the thaw front (S_l = ½) and the 
 surface (Figs. 20–22), and the thaw depths and displacements against time. planar_slump: the
 planar slope after Harris et al. (2001) (configs/paper/thaw_slump_planar.yaml), one row per run:
 plastic deviatoric strain and u_x at one frame, and the thaw depth and movement against time with
-the depth at which the infinite-slope factor of safety is 1. footing_rates: the
+the depth at which the infinite-slope factor of safety is 1. planar_onset: the same scene on several
+meshes (fields.h5 frames every 0.05 d or so): when the surface point from x = 0.7 m has moved 1 mm,
+the depth of ice-free soil (T ≥ 0, where S_l = 1) in the material points' column at x = 0.7 m, against the
+cell size, with the first-order extrapolation of the two finest and the infinite slope's limit
+depth; the numbers are printed as a table. footing_rates: the
 strip footing pushed at different speeds (Sec. 5.3.2, Fig. 28): for each run the plastic deviatoric
 strain at d/B = 0.5, 1 and 1.5 with the 0 and −1 °C lines, and the footing pressures against d/B.
 Each OUT is a run folder (metrics.csv, fields.h5).
@@ -518,6 +523,55 @@ def planar_slump(folders, png, frame):
     frostplot.save(fig, png)
 
 
+def planar_onset(folders, png):
+    """Onset of sliding on the planar slope against the cell size: the ice-free depth (the soil the
+    layer can slip in: the ice's cohesion acts from the first ice) in the material points' column at
+    x = 0.7 m when the surface point above has moved 1 mm downslope."""
+    _, limit = planar_slope_geometry(folders[0])
+    sizes, depths = [], []
+    print("cell [m]  onset [d]  ice-free depth [m]  S_l = 1/2 depth (probe) [m]")
+    for folder in folders:
+        grid = frostplot.run_summary(folder)["resolved_scene"]["grid"]
+        h = grid["cell_size"][0]
+        spacing = h / grid["particles_per_cell"]
+        m = metrics(folder)
+        t, u = np.asarray(m["time_s"]), np.asarray(m["surface_middle_x"])
+        i = int(np.nonzero(u >= 1e-3)[0][0])
+        onset = t[i - 1] + (t[i] - t[i - 1]) * (1e-3 - u[i - 1]) / (u[i] - u[i - 1])
+        times, ice_free = [], []
+        for fr in frostplot.read_fields.read_frames(folder):
+            start = fr["coordinates"][:, :2] - np.asarray(fr["fields"]["displacement"])[:, :2]
+            column = np.abs(start[:, 0] - 0.7) < 0.51 * spacing
+            top = start[:, 1].max() + 0.5 * spacing
+            order = np.argsort(top - start[column, 1])
+            depth = (top - start[column, 1])[order]
+            # Ice-free down to T = 0 (the freezing curve holds S_l = 1 above it): the first crossing,
+            # linear between the two material points either side of it.
+            T = np.asarray(fr["fields"]["temperature"])[column][order]
+            k = int(np.nonzero(T < 0)[0][0])
+            ice_free.append(0.0 if k == 0 else depth[k - 1] + (depth[k] - depth[k - 1]) * T[k - 1] / (T[k - 1] - T[k]))
+            times.append(fr["time"])
+        sizes.append(h)
+        depths.append(float(np.interp(onset, times, ice_free)))
+        probe = float(np.interp(onset, t, m["thaw_depth_middle"]))
+        print(f"{h:8.4f}  {onset:9.3f}  {depths[-1]:18.4f}  {probe:27.4f}")
+    order = np.argsort(sizes)
+    sizes, depths = np.asarray(sizes)[order], np.asarray(depths)[order]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(sizes, depths, "o-", label="ice-free depth when the middle has moved 1 mm")
+    if len(sizes) >= 2:
+        slope = (depths[1] - depths[0]) / (sizes[1] - sizes[0])
+        extrapolated = depths[0] - slope * sizes[0]
+        print(f"first-order extrapolation of the two finest: {extrapolated:.4f} m (limit depth {limit:.4f} m)")
+        ax.plot([0, sizes[0]], [extrapolated, depths[0]], "k--", lw=1,
+                label=f"first order, h → 0: {extrapolated:.3f} m")
+    ax.axhline(limit, color="k", ls=":", label=f"FS = 1 (infinite slope, drained): {limit:.3f} m")
+    ax.set(xlabel="cell size h [m]", ylabel="depth [m]", xlim=(0, None), ylim=(0, None),
+           title="planar slope: onset of sliding against the mesh")
+    ax.legend(fontsize=7)
+    frostplot.save(fig, png)
+
+
 def footing_rates(folders, png):
     """Plastic deviatoric strain at d/B = 0.5, 1, 1.5 per run with the 0 and −1 °C lines (Fig. 28),
     and footing pressure against d/B (one line per run)."""
@@ -557,7 +611,7 @@ def main():
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
                                                       "footing_thermal", "footing", "slump", "planar_slump",
-                                                      "footing_rates"])
+                                                      "planar_onset", "footing_rates"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -583,6 +637,8 @@ def main():
         slump(args.folders[0], png, args.frame)
     elif args.figure == "planar_slump":
         planar_slump(args.folders, png, args.frame)
+    elif args.figure == "planar_onset":
+        planar_onset(args.folders, png)
     elif args.figure == "footing_rates":
         footing_rates(args.folders, png)
     else:
