@@ -53,8 +53,8 @@
 
 #include "frostmpm/linalg/conjugate_gradient.hpp"
 #include "frostmpm/linalg/csr_matrix.hpp"
-#include "frostmpm/linalg/mpi_session.hpp"
 #include "frostmpm/linalg/galerkin_product.hpp"
+#include "frostmpm/linalg/mpi_session.hpp"
 #include "frostmpm/linalg/multigrid_cycle.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 
@@ -396,8 +396,7 @@ struct SparseSystem::Impl {
       std::vector<CsrMatrix> operators{current}, prolongators;
       if (refresh && !muelu.is_null()) {
         // New values on the build's prolongators (what MueLu's "RP" reuse keeps), the coarse
-        // operators Pᵀ A P by our own threaded product: MueLu's serial one cost about two CG
-        // iterations a refresh (9 % frozen inclusion at 0.01 m).
+        // operators Pᵀ A P by our own threaded product (MueLu's reuse computes them serially).
         for (const auto& product : galerkin) {
           operators.push_back(product(operators.back()));
           prolongators.push_back(product.prolongator());
