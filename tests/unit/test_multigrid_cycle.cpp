@@ -137,6 +137,16 @@ TEST_CASE("A multigrid V-cycle with hybrid l1 Gauss-Seidel is symmetric, positiv
   REQUIRE(std::abs(uBv - vBu) <= 1e-11 * std::abs(uBv));
   REQUIRE(dot(u, Bu) > 0);
   REQUIRE(dot(v, Bv) > 0);
+
+  // The restrictions handed in (a refresh reuses its build's Pᵀ) give the same cycle bit for bit;
+  // one that is not a prolongator's transpose is refused.
+  const CsrMatrix P0 = aggregation(m), A1 = galerkin(A, P0), P1 = aggregation(m / 2), A2 = galerkin(A1, P1);
+  MultigridCycle given({A, A1, A2}, {P0, P1}, {P0.transpose(), P1.transpose()});
+  std::vector<double> Bu_given(n);
+  given.apply(u, Bu_given);
+  REQUIRE(Bu_given == Bu);
+  REQUIRE_THROWS_AS(MultigridCycle({A, A1, A2}, {P0, P1}, {P0.transpose()}), std::invalid_argument);
+  REQUIRE_THROWS_AS(MultigridCycle({A, A1, A2}, {P0, P1}, {P1.transpose(), P0.transpose()}), std::invalid_argument);
 }
 
 TEST_CASE("CG with the V-cycle converges across a six-order coefficient jump, Jacobi far slower", "[linalg]") {

@@ -4,22 +4,16 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "frostmpm/parallel/parallel.hpp"
 
 namespace frostmpm {
 
-JacobiPreconditioner::JacobiPreconditioner(const CsrMatrix& A) : inverse_diagonal_(A.diagonal()) {
-  for (double& d : inverse_diagonal_) d = d != 0 ? 1.0 / d : 1.0;
-}
+JacobiPreconditioner::JacobiPreconditioner(const CsrMatrix& A) : JacobiPreconditioner(A.diagonal()) {}
 
-JacobiPreconditioner::JacobiPreconditioner(std::span<const double> values,
-                                           std::span<const std::size_t> diagonal_position)
-    : inverse_diagonal_(diagonal_position.size()) {
-  parallel_for(diagonal_position.size(), [&](std::size_t i) {
-    const double d = diagonal_position[i] == no_entry ? 0.0 : values[diagonal_position[i]];
-    inverse_diagonal_[i] = d != 0 ? 1.0 / d : 1.0;
-  });
+JacobiPreconditioner::JacobiPreconditioner(std::vector<double> diagonal) : inverse_diagonal_(std::move(diagonal)) {
+  for (double& d : inverse_diagonal_) d = d != 0 ? 1.0 / d : 1.0;
 }
 
 void JacobiPreconditioner::apply(std::span<const double> r, std::span<double> z) {

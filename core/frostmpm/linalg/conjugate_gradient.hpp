@@ -20,10 +20,9 @@ class LinearPreconditioner {
 /// z = D⁻¹ r (rows whose diagonal is zero pass r through).
 class JacobiPreconditioner final : public LinearPreconditioner {
  public:
-  static constexpr std::size_t no_entry = std::size_t(-1);
   explicit JacobiPreconditioner(const CsrMatrix& A);
-  /// a_ii = values[diagonal_position[i]] (no_entry: none), without scanning the rows.
-  JacobiPreconditioner(std::span<const double> values, std::span<const std::size_t> diagonal_position);
+  /// From the diagonal a_ii itself (a caller that knows where its diagonal entries are).
+  explicit JacobiPreconditioner(std::vector<double> diagonal);
   void apply(std::span<const double> r, std::span<double> z) override;
 
  private:

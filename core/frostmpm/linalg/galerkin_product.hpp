@@ -21,6 +21,7 @@ class GalerkinProduct {
   CsrMatrix operator()(const CsrMatrix& A) const;
 
   const CsrMatrix& prolongator() const { return P_; }
+  const CsrMatrix& restriction() const { return R_; }  ///< Pᵀ, each row's columns ascending
   /// The pattern of Pᵀ A P (values zero): the fine pattern of the next coarser product.
   const CsrMatrix& coarse_pattern() const { return coarse_; }
 

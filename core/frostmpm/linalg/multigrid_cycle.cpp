@@ -10,10 +10,15 @@
 
 namespace frostmpm {
 
-MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators) {
+MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators,
+                               std::vector<CsrMatrix> restrictions) {
   if (operators.empty() || prolongators.size() + 1 != operators.size())
     throw std::invalid_argument("MultigridCycle: needs one prolongator fewer than operators (got " +
                                 std::to_string(operators.size()) + " and " + std::to_string(prolongators.size()) +
+                                ")");
+  if (!restrictions.empty() && restrictions.size() != prolongators.size())
+    throw std::invalid_argument("MultigridCycle: needs a restriction per prolongator or none (got " +
+                                std::to_string(restrictions.size()) + " and " + std::to_string(prolongators.size()) +
                                 ")");
   levels_.resize(operators.size());
   for (std::size_t l = 0; l < operators.size(); ++l) {
@@ -28,7 +33,10 @@ MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<Csr
                                     std::to_string(level.P.rows) + " × " + std::to_string(level.P.cols) +
                                     ", levels have " + std::to_string(n) + " and " +
                                     std::to_string(operators[l + 1].rows) + " rows");
-      level.R = level.P.transpose();
+      level.R = restrictions.empty() ? level.P.transpose() : std::move(restrictions[l]);
+      if (level.R.rows != level.P.cols || level.R.cols != level.P.rows || level.R.nonzeros() != level.P.nonzeros())
+        throw std::invalid_argument("MultigridCycle: restriction " + std::to_string(l) +
+                                    " is not the prolongator's transpose");
     }
     // Equal blocks, so that 2, 4 or 8 threads share the sweep evenly.
     const std::size_t blocks = std::max<std::size_t>(1, (n + kSmootherBlockRows - 1) / kSmootherBlockRows);

@@ -30,8 +30,10 @@ class MultigridCycle final : public LinearPreconditioner {
 
   /// operators[0] is the finest matrix, operators[l + 1] = Rₗ Aₗ Pₗ its coarser ones;
   /// prolongators[l] maps level l + 1 to level l (one fewer than the operators). The restriction
-  /// is Pₗᵀ. Throws std::invalid_argument for sizes that do not chain.
-  MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators);
+  /// is Pₗᵀ: given in `restrictions` (as CsrMatrix::transpose makes it) or, when that is empty,
+  /// transposed here. Throws std::invalid_argument for sizes that do not chain.
+  MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators,
+                 std::vector<CsrMatrix> restrictions = {});
 
   /// z = one V-cycle applied to r from a zero guess.
   void apply(std::span<const double> r, std::span<double> z) override;

@@ -183,6 +183,7 @@ struct SparseSystem::Impl {
   std::vector<LO> sorted_columns;   ///< per row, ascending
   std::vector<std::size_t> order;   ///< sorted position k -> index into columns/values
   std::vector<std::size_t> storage_position;  ///< caller's entry -> index in Tpetra's values
+  static constexpr std::size_t no_entry = std::size_t(-1);
   std::vector<std::size_t> diagonal_position;  ///< row -> its diagonal entry's index, or no_entry
   bool values_dirty = true;         ///< values changed since the last solve
   SolverOptions options;
@@ -255,7 +256,7 @@ struct SparseSystem::Impl {
     }
     order.resize(columns.size());
     sorted_columns.resize(columns.size());
-    diagonal_position.assign(n, JacobiPreconditioner::no_entry);
+    diagonal_position.assign(n, no_entry);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t begin = offsets[i], end = offsets[i + 1];
       for (std::size_t k = begin; k < end; ++k) {
@@ -390,16 +391,22 @@ struct SparseSystem::Impl {
   void build_own_preconditioner(bool refresh) {
     const auto& kind = options.preconditioner;
     if (kind == "jacobi") {
-      own_preconditioner = std::make_unique<JacobiPreconditioner>(current.values, diagonal_position);
+      // The diagonal from its stored positions, not by scanning the rows.
+      std::vector<double> diagonal(n);
+      parallel_for(n, [&](std::size_t i) {
+        diagonal[i] = diagonal_position[i] == no_entry ? 0.0 : current.values[diagonal_position[i]];
+      });
+      own_preconditioner = std::make_unique<JacobiPreconditioner>(std::move(diagonal));
       record_source(refresh);
     } else if (kind == "multigrid") {
-      std::vector<CsrMatrix> operators{current}, prolongators;
+      std::vector<CsrMatrix> operators{current}, prolongators, restrictions;
       if (refresh && !muelu.is_null()) {
         // New values on the build's prolongators (what MueLu's "RP" reuse keeps), the coarse
         // operators Pᵀ A P by our own threaded product (MueLu's reuse computes them serially).
         for (const auto& product : galerkin) {
           operators.push_back(product(operators.back()));
           prolongators.push_back(product.prolongator());
+          restrictions.push_back(product.restriction());  // transposed once per build, not per refresh
         }
         record_source(true);
       } else {
@@ -411,7 +418,8 @@ struct SparseSystem::Impl {
         const CsrMatrix* pattern = &current;
         for (const auto& P : prolongators) pattern = &galerkin.emplace_back(*pattern, P).coarse_pattern();
       }
-      own_preconditioner = std::make_unique<MultigridCycle>(std::move(operators), std::move(prolongators));
+      own_preconditioner =
+          std::make_unique<MultigridCycle>(std::move(operators), std::move(prolongators), std::move(restrictions));
     }
     have_preconditioner = true;
   }
