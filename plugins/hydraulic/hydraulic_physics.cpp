@@ -36,12 +36,21 @@ ParamSchema HydraulicPhysics::schema() {
          "material's shear_modulus; damps checkerboard pressure modes; 0 switches it off")
       .defaults_to(1.0)
       .at_least(0);
+  s.real("cavitation_pressure", "Pa",
+         "lowest pore pressure (gauge) the water takes: below it the water cavitates, the nodes are held at this "
+         "value and the volume they lack counts as vapour (hydraulic.cavitated_volume); about -1.0e5 for water "
+         "at atmospheric pressure")
+      .optional("no limit: the pore water takes any suction")
+      .at_most(0)
+      .at_least(-1e9);
   return s;
 }
 
 HydraulicPhysics::HydraulicPhysics(const ParamSet& p) : params_(p) {
   reference_gravity_ = p.real("reference_gravity");
   phase_change_source_ = p.boolean("phase_change_source");
+  cavitation_ = p.has("cavitation_pressure");
+  if (cavitation_) cavitation_pressure_ = p.real("cavitation_pressure");
 }
 
 ParamSchema HydraulicPhysics::material_schema() const {
@@ -536,6 +545,7 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0, removed_water_});
   saved_scalars_.insert(saved_scalars_.end(), {system_ ? 1.0 : 0.0, preconditioner_built_ ? 1.0 : 0.0,
                                                refresh_due_ ? 1.0 : 0.0, double(iterations_after_refresh_)});
+  saved_scalars_.insert(saved_scalars_.end(), {cavitated_volume_, double(cavitated_nodes_max_)});
   saved_groups_ = {double(graph_groups_.size())};
   for (const auto& group : graph_groups_) {
     saved_groups_.push_back(double(group.size()));
@@ -553,8 +563,10 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 13)
-    throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 13");
+  if (s.size() != 15)
+    throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 15");
+  cavitated_volume_ = s[13];
+  cavitated_nodes_max_ = long(s[14]);
   // The pressure system as it was: assemble() builds it with the saved plate rows and rebuilds
   // the preconditioner from the values it was made from; the next solve starts from the carried Δp.
   restore_system_ = s[9] != 0;
@@ -602,7 +614,9 @@ std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const
           {"hydraulic.preconditioner_seconds", preconditioner_seconds_},
           {"hydraulic.source_volume", source_volume_},
           {"hydraulic.boundary_inflow_volume", boundary_inflow_},
-          {"hydraulic.water_removed_volume", removed_water_}};
+          {"hydraulic.water_removed_volume", removed_water_},
+          {"hydraulic.cavitated_volume", cavitated_volume_},
+          {"hydraulic.cavitated_nodes_max", double(cavitated_nodes_max_)}};
 }
 
 void HydraulicPhysics::removing_particles(const ParticleRemoval& removal) {

@@ -127,6 +127,8 @@ class HydraulicPhysics final : public Physics {
   double mass_scaling_ = 1;
   double transport_scaling_ = 1;  ///< time.transport_scaling: the factor on every permeability
   bool phase_change_source_ = true;
+  bool cavitation_ = false;          ///< physics.hydraulic.cavitation_pressure given
+  double cavitation_pressure_ = 0;   ///< the lowest pore pressure the water takes [Pa]
   double reference_gravity_ = 9.81;
   double hydrostatic_density_ = 1000;  ///< ρ_l of a hydrostatic boundary (the scene's one water density)
   std::vector<MaterialModels> materials_;
@@ -173,6 +175,10 @@ class HydraulicPhysics final : public Physics {
   StencilGraph compact_;  ///< coupled: the particle-stencil pattern of Q (graph_ is its square)
   std::unique_ptr<SparseSystem> system_;
   std::vector<double> values_;
+  std::vector<char> fixed_;  ///< rows whose Δp is prescribed (pressure boundaries, dry or empty nodes)
+  // With a cavitation limit: the system before the elimination, from which the rows of the nodes
+  // that cavitate are eliminated in turn (limit_to_cavitation())
+  std::vector<double> values_free_, rhs_free_;
   bool preconditioner_built_ = false;  ///< for the current system
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
   bool refresh_due_ = false;           ///< the iteration count grew by more than 2 since the last update
@@ -194,6 +200,8 @@ class HydraulicPhysics final : public Physics {
   double source_volume_ = 0;    ///< water volume the phase change and thermal expansion removed [m³ per m]
   double removed_water_ = 0;  ///< liquid water volume of the particles removed after leaving the grid
   double boundary_inflow_ = 0;  ///< water volume that entered through pressure and flux boundaries
+  double cavitated_volume_ = 0;  ///< volume the cavitated nodes lacked, filled by vapour [m³ per m]
+  long cavitated_nodes_max_ = 0;  ///< most nodes held at the cavitation pressure in one step
   std::vector<double> saved_scalars_;
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
@@ -222,6 +230,17 @@ class HydraulicPhysics final : public Physics {
   /// Coupled: the drag stiffness C_d ξ, the reaction k ṽ − f_l and the share n_l ξ the skeleton needs.
   void drag();
   void solve_pressure();
+  /// One solve of the system as it stands (values_, rhs_ into Δp), its counters and the stop on
+  /// a solve that did not converge.
+  void solve_system(PreconditionerUpdate update);
+  /// Replaces the rows and columns of the `held` nodes by the identity, their Δp (already set)
+  /// moved to the right-hand side: A stays symmetric.
+  void eliminate_rows(const std::vector<char>& held);
+  /// The cavitation limit: nodes whose pressure fell below it are held there and the system
+  /// solved again, until every free node is at or above it and every held node lacks water.
+  void limit_to_cavitation();
+  /// (A Δp − b)_i of node i's unconstrained row: the water the node takes in over Δt.
+  double unconstrained_residual(std::size_t i) const;
   void correct();
   void map_to_particles();
   void assemble();
