@@ -221,6 +221,8 @@ std::vector<Stage> HydraulicPhysics::stages() {
   Stage drag_stage{"hydraulic.drag", Phase::PredictMomentum, {node_pressure_.read(), v, m_s},
                    {liquid_drag_.write(), liquid_reaction_.write(), liquid_share_.write()}, [this] { drag(); }};
   drag_stage.skippable = true;  // only a skeleton that moves reads what it writes
+  std::vector<FieldRef> pressure_writes{dp};
+  if (cavitation_) pressure_writes.push_back(vapour_.write());  // the vapour: state of the pressure solve
   return {{"hydraulic.map_to_grid", Phase::MapToGrid, {x, vol, phi, S, p, T, m_s, node_solid_start_.optional_read()},
            {p_node},
            [this] { map_to_grid(); }},
@@ -230,7 +232,7 @@ std::vector<Stage> HydraulicPhysics::stages() {
           {"hydraulic.pressure", Phase::Pressure,
            {v_star, node_pressure_.read(), vs_star, node_solid_mobility_.optional_read(),
             node_solid_group_.optional_read(), shear_modulus_.optional_read()},
-           {dp},
+           pressure_writes,
            [this] { solve_pressure(); }},
           {"hydraulic.correct", Phase::CorrectMomentum,
            {v_star, node_increment_.read(), node_pressure_.read(), vs, vs_star},

@@ -367,21 +367,24 @@ void HydraulicPhysics::account_boundary_inflow() {
 
 void HydraulicPhysics::solve_pressure() {
   assemble();
+  // With vapour from earlier steps, the first solve already holds its nodes (limit_to_cavitation).
+  const bool vapour = cavitation_ && gather_vapour();
   // The matrix changes every step a thermal physics moves the ice, but only near the front:
   // the preconditioner of an earlier step stays good for a while. A refresh (new values on the
   // kept aggregates) costs about two CG iterations (9 % frozen inclusion: 19 ms against 8.7 ms an
   // iteration at 0.01 m, 4.3 against 2.0 ms at 0.02 m), so it is due as soon as a step needs more
   // than two iterations over the count right after the last refresh (and built on a new graph).
-  solve_system(!preconditioner_built_ ? PreconditionerUpdate::Rebuild
-               : refresh_due_         ? PreconditionerUpdate::Refresh
-                                      : PreconditionerUpdate::Reuse);
-  if (cavitation_) limit_to_cavitation();
+  if (!vapour)
+    solve_system(!preconditioner_built_ ? PreconditionerUpdate::Rebuild
+                 : refresh_due_         ? PreconditionerUpdate::Refresh
+                                        : PreconditionerUpdate::Reuse);
+  if (cavitation_) limit_to_cavitation(vapour);
 }
 
-void HydraulicPhysics::solve_system(PreconditionerUpdate update) {
+void HydraulicPhysics::solve_system(PreconditionerUpdate update, double tolerance) {
   system_->set_values(values_);
   const auto start = std::chrono::steady_clock::now();
-  const SolveStats stats = system_->solve(rhs_, *dp_, update);
+  const SolveStats stats = system_->solve(rhs_, *dp_, update, tolerance);
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   preconditioner_seconds_ += stats.setup_seconds;
   ++solves_;
@@ -415,56 +418,118 @@ double HydraulicPhysics::unconstrained_residual(std::size_t i) const {
   return r;
 }
 
-/// The pore water cannot take a pressure below the cavitation pressure p_c: the mass balance and
-/// p ≥ p_c form a complementarity problem — at every node either p > p_c and the balance holds,
-/// or p = p_c and the node lacks water (its unconstrained residual, the water it would have to
-/// take in, is ≥ 0), which vapour fills. Solved by a primal–dual active set: nodes below p_c are
-/// held at it, held nodes with a surplus are let go, the system solved again, until nothing
-/// changes. Releases stop after kReleaseRounds, so the set only grows from then on and the loop
-/// ends. The vapour keeps no memory: the next step starts from the nodal pressures, and a held
-/// node whose neighbours push water back rises above p_c at once.
-void HydraulicPhysics::limit_to_cavitation() {
+bool HydraulicPhysics::gather_vapour() {
+  const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
+  const auto f = vapour_.values();
+  const std::size_t nodes = fixed_.size();
+  node_vapour_.assign(nodes, 0.0);
+  vapour_weight_.assign(nodes, 0.0);
+  const int K = st.per_particle();
+  kernel_->transfer().scatter([&](std::size_t q) {
+    const auto* n = st.nodes(q);
+    const auto* w = st.weights(q);
+    for (int k = 0; k < K; ++k) {
+      node_vapour_[n[k]] += w[k] * f[q] * vol[q];
+      vapour_weight_[n[k]] += w[k] * vol[q];
+    }
+  });
+  // Fixed rows (a drained node, an empty one) lose theirs: the boundary supplies the water.
+  bool any = false;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    if (fixed_[i]) node_vapour_[i] = 0.0;
+    any = any || node_vapour_[i] > 0;
+  }
+  return any;
+}
+
+/// The pore water cannot take a pressure below the cavitation pressure p_c; below it, vapour
+/// fills the pores the water cannot. Per node, with V_i the vapour of the step's start and
+/// r_i = (A Δp − b)_i the water the node takes in (its unconstrained row): either the node is
+/// free, p_i ≥ p_c, and its water fills the vapour (r_i = −V_i/Δt), or it is held at p_c and
+/// keeps V_i + Δt r_i ≥ 0 of vapour — a complementarity problem, solved by a primal–dual active
+/// set: free nodes below p_c are held, held nodes whose vapour would be used up are let go, and
+/// the system is solved again, until nothing changes. Releases stop after kReleaseRounds, so the
+/// set only grows from then on and the loop ends. Without vapour and with no node below p_c,
+/// the first solve stands.
+void HydraulicPhysics::limit_to_cavitation(bool vapour) {
   constexpr int kReleaseRounds = 8;
   const std::size_t nodes = fixed_.size();
   const auto& p = *p_;
   auto& dp = *dp_;
-  std::vector<char> cavitated(nodes, 0);
+  // Nodes with vapour start held (a free one would have to draw its vapour's volume of water
+  // through frozen ground within the step: a first solve far from the answer).
+  std::vector<char> held(nodes, 0);
+  for (std::size_t i = 0; i < nodes; ++i) held[i] = node_vapour_[i] > 0;
   // Below by more than the solve's round-off (a released node may land a hair under p_c).
   const double margin = 1e-9 * std::max(std::abs(cavitation_pressure_), 1.0);
   for (int round = 0;; ++round) {
-    bool changed = false;
-    for (std::size_t i = 0; i < nodes; ++i) {
+    bool changed = vapour && round == 0;  // the first solve is still to come
+    for (std::size_t i = 0; i < nodes && !(vapour && round == 0); ++i) {
       if (fixed_[i]) continue;
-      if (!cavitated[i] && p[i] + dp[i] < cavitation_pressure_ - margin) {
-        cavitated[i] = 1;
+      if (!held[i] && p[i] + dp[i] < cavitation_pressure_ - margin) {
+        held[i] = 1;
         changed = true;
-      } else if (cavitated[i] && round < kReleaseRounds && unconstrained_residual(i) < 0) {
-        cavitated[i] = 0;
+      } else if (held[i] && round < kReleaseRounds && node_vapour_[i] + dt_ * unconstrained_residual(i) < 0) {
+        held[i] = 0;
         changed = true;
       }
     }
     if (!changed) break;
     values_ = values_free_;
     rhs_ = rhs_free_;
-    std::vector<char> held(fixed_);
     for (std::size_t i = 0; i < nodes; ++i)
-      if (cavitated[i]) {
-        held[i] = 1;
+      if (!fixed_[i] && node_vapour_[i] > 0) rhs_[i] -= node_vapour_[i] / dt_;
+    std::vector<char> rows(fixed_);
+    for (std::size_t i = 0; i < nodes; ++i)
+      if (held[i]) {
+        rows[i] = 1;
         dp[i] = cavitation_pressure_ - p[i];
       }
-    eliminate_rows(held);
-    solve_system(PreconditionerUpdate::Refresh);
+    eliminate_rows(rows);
+    // Solved for the correction to the Δp just set, to the tolerance relative to the free rows'
+    // right-hand side: the held rows' (their jumps to p_c, in Pa) would otherwise dominate |b|
+    // and leave the free rows' water balance unsolved. Their correction is zero.
+    double free_norm2 = 0, start_norm2 = 0;
+    for (std::size_t i = 0; i < nodes; ++i)
+      if (!rows[i]) free_norm2 += rhs_[i] * rhs_[i];
+    const std::vector<double> start(dp);
+    parallel_for(nodes, [&](std::size_t i) {
+      double a_x = 0;
+      for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e)
+        a_x += values_[e] * start[static_cast<std::size_t>(graph_.columns[e])];
+      rhs_[i] -= a_x;
+    });
+    for (std::size_t i = 0; i < nodes; ++i) start_norm2 += rhs_[i] * rhs_[i];
+    const double tolerance = params_.real("linear_tolerance");
+    std::fill(dp.begin(), dp.end(), 0.0);
+    solve_system(preconditioner_built_ ? PreconditionerUpdate::Refresh : PreconditionerUpdate::Rebuild,
+                 start_norm2 > 0 ? std::min(0.1, tolerance * std::sqrt(free_norm2 / start_norm2)) : tolerance);
+    for (std::size_t i = 0; i < nodes; ++i) dp[i] += start[i];
     refresh_due_ = true;  // the next step's matrix is the unconstrained one again
   }
-  double lacking = 0;
+  // The vapour at the step's end: what the held nodes keep; free nodes' water filled theirs.
+  double total = 0;
   long count = 0;
-  for (std::size_t i = 0; i < nodes; ++i)
-    if (cavitated[i]) {
-      lacking += unconstrained_residual(i);
-      ++count;
-    }
-  cavitated_volume_ += dt_ * lacking;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    node_vapour_[i] = held[i] ? std::max(node_vapour_[i] + dt_ * unconstrained_residual(i), 0.0) : 0.0;
+    total += node_vapour_[i];
+    count += held[i];
+  }
+  cavitated_volume_ = total;
   cavitated_nodes_max_ = std::max(cavitated_nodes_max_, count);
+  // Back to the particles in proportion to S_ip V_p, so that their vapour sums to the nodes'.
+  const auto& st = kernel_->transfer().stencil();
+  auto f = vapour_.mutable_values();
+  const int K = st.per_particle();
+  parallel_for(f.size(), [&](std::size_t q) {
+    const auto* n = st.nodes(q);
+    const auto* w = st.weights(q);
+    double share = 0;
+    for (int k = 0; k < K; ++k)
+      if (vapour_weight_[n[k]] > 0) share += w[k] * node_vapour_[n[k]] / vapour_weight_[n[k]];
+    f[q] = share;
+  });
 }
 
 }  // namespace frostmpm::hydraulic

@@ -94,16 +94,18 @@ TEST_CASE("a sealed column that thaws through cavitates: held at the cavitation 
           "[verification][hydraulic][sources][cavitation]") {
   // Frozen at −5 °C (S_l = S_res = 0.05), sealed on every face, warmed to +5 °C on both ends until
   // it has thawed through (S_l = 1). The meltwater lacks ζ φ (1 − S_res) of the column's volume;
-  // without a limit the pore water stretches to fill it (tens of MPa of suction), with a cavitation
-  // pressure p_c the water stays at p_c and the vapour takes the deficit, less what the water's
-  // own expansion at p_c supplies (φ c_w |p_c|, 6e-4 of it here).
+  // without a limit the pore water stretches to fill it (hundreds of MPa of suction), with a
+  // cavitation pressure p_c the water stays at p_c and the vapour takes the deficit, less what the
+  // water's own expansion at p_c supplies (φ c_w |p_c|, 6e-4 of it here). Then cooled back to
+  // −5 °C: the ice's expansion fills the vapour again, and a full cycle leaves none.
   TempDir dir;
   const double zeta = 1 - 917.0 / 1000.0, phi = 0.37, residual = 0.05, p_c = -1.0e5;
-  auto scene = [&](double h) {
+  auto scene = [&](double h, bool refreeze) {
     const long cells = std::lround(0.2 / h);
+    const std::string warm = refreeze ? "{expression: \"t < 4.0e5 ? 5.0 : -5.0\"}" : "5.0";
     std::string text = "task: simulation\n"
                        "grid: {cells: [1, " + std::to_string(cells) + "], cell_size: " + std::to_string(h) + "}\n"
-                       "time: {end: 4.0e5, dt: 600}\n"
+                       "time: {end: " + std::string(refreeze ? "8.0e5" : "4.0e5") + ", dt: 600}\n"
                        "physics:\n  thermal: {scheme: implicit}\n  hydraulic: {}\n"
                        "materials:\n  sand:\n    porosity: 0.37\n    solid_density: 2650\n"
                        "    solid_heat_capacity: 835\n    solid_conductivity: 9.0\n"
@@ -112,36 +114,44 @@ TEST_CASE("a sealed column that thaws through cavitates: held at the cavitation 
                        "    relative_permeability: {model: impedance, omega: 50}\n"
                        "regions:\n  - shape: {box: {min: [0, 0], max: [" + std::to_string(h) + ", 0.2]}}\n"
                        "    material: sand\n    initial: {temperature: -5.0}\n"
-                       "boundary_conditions:\n  - {type: temperature, nodes: {face: y_min}, value: 5.0}\n"
-                       "  - {type: temperature, nodes: {face: y_max}, value: 5.0}\n"
+                       "boundary_conditions:\n  - {type: temperature, nodes: {face: y_min}, value: " + warm + "}\n"
+                       "  - {type: temperature, nodes: {face: y_max}, value: " + warm + "}\n"
                        "output: {every: 0}\n"
                        "probes:\n  - {name: p_min, type: min, field: pore_pressure}\n"
-                       "  - {name: S_min, type: min, field: liquid_saturation}\n";
-    const std::string path = dir.file("sealed_" + std::to_string(cells) + ".yaml");
+                       "  - {name: S_min, type: min, field: liquid_saturation}\n"
+                       "  - {name: S_max, type: max, field: liquid_saturation}\n";
+    const std::string path = dir.file("sealed_" + std::to_string(cells) + (refreeze ? "_cycle" : "") + ".yaml");
     write_file(path, text);
     return path;
   };
+  const std::string limit = " --set physics.hydraulic.cavitation_pressure=" + std::to_string(p_c);
   for (double h : {0.02, 0.01}) {
-    const std::string path = scene(h), out = dir.file("out_" + std::to_string(std::lround(0.2 / h)));
-    const auto unlimited = run_frostmpm("run " + path + " -o " + out + "_free");
-    const auto r = run_frostmpm("run " + path + " -o " + out + " --set physics.hydraulic.cavitation_pressure=" +
-                                std::to_string(p_c));
-    INFO(r.output << unlimited.output);
+    const std::string out = dir.file("out_" + std::to_string(std::lround(0.2 / h)));
+    const auto unlimited = run_frostmpm("run " + scene(h, false) + " -o " + out + "_free");
+    const auto r = run_frostmpm("run " + scene(h, false) + " -o " + out + limit);
+    const auto cycle = run_frostmpm("run " + scene(h, true) + " -o " + out + "_cycle" + limit);
+    INFO(r.output << unlimited.output << cycle.output);
     REQUIRE(r.exit_code == 0);
     REQUIRE(unlimited.exit_code == 0);
+    REQUIRE(cycle.exit_code == 0);
     const auto limited = read_csv(out + "/metrics.csv"), free = read_csv(out + "_free/metrics.csv");
-    const double S_min = limited.rows.back()[limited.column("S_min")];
-    REQUIRE(S_min > 0.999);  // thawed through
+    REQUIRE(limited.rows.back()[limited.column("S_min")] > 0.999);  // thawed through
     const double p_min = limited.rows.back()[limited.column("p_min")];
     const double p_free = free.rows.back()[free.column("p_min")];
     const double deficit = zeta * phi * (1 - residual) * h * 0.2;  // m³ per m
     const double expected = deficit - phi * 4.6e-10 * -p_c * h * 0.2;
     const double vapour = run_counter(out, "hydraulic.cavitated_volume");
+    const auto refrozen = read_csv(out + "_cycle/metrics.csv");
+    REQUIRE(refrozen.rows.back()[refrozen.column("S_max")] < 0.0501);  // frozen again
+    const double left = run_counter(out + "_cycle", "hydraulic.cavitated_volume");
     WARN("h = " << h << " m: p_min " << p_min << " Pa (without the limit " << p_free << " Pa), vapour " << vapour
-                << " m³/m against " << expected << " (error " << 100 * std::abs(vapour / expected - 1) << " %)");
+                << " m³/m against " << expected << " (error " << 100 * std::abs(vapour / expected - 1)
+                << " %); after refreezing " << left << " m³/m (" << 100 * left / expected << " %)");
     CHECK(p_free < 100 * p_c);                       // the limit is what holds it
     CHECK(p_min == Approx(p_c).epsilon(1e-6));       // held at p_c, not below
     CHECK(vapour == Approx(expected).epsilon(1e-3));  // the deficit, less the water's expansion
     CHECK(run_counter(out, "hydraulic.source_volume") == Approx(deficit).epsilon(1e-3));
+    CHECK(left < 0.01 * expected);  // the ice's expansion filled the vapour again
+    CHECK(refrozen.rows.back()[refrozen.column("p_min")] >= p_c);
   }
 }
