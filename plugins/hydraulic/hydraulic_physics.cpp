@@ -547,7 +547,7 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_scalars_.insert(saved_scalars_.end(), {source_volume_, boundary_inflow_, primed_ ? 1.0 : 0.0, removed_water_});
   saved_scalars_.insert(saved_scalars_.end(), {system_ ? 1.0 : 0.0, preconditioner_built_ ? 1.0 : 0.0,
                                                refresh_due_ ? 1.0 : 0.0, double(iterations_after_refresh_)});
-  saved_scalars_.insert(saved_scalars_.end(), {cavitated_volume_, double(cavitated_nodes_max_)});
+  saved_scalars_.insert(saved_scalars_.end(), {cavitated_volume_, double(cavitated_nodes_max_), unresolved_volume_});
   saved_groups_ = {double(graph_groups_.size())};
   for (const auto& group : graph_groups_) {
     saved_groups_.push_back(double(group.size()));
@@ -565,10 +565,12 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
 
 void HydraulicPhysics::restored() {
   const auto& s = saved_scalars_;
-  if (s.size() != 15)
-    throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 15");
-  cavitated_volume_ = s[13];
-  cavitated_nodes_max_ = long(s[14]);
+  // 13: written before the cavitation limit existed (its counters start at zero).
+  if (s.size() != 16 && s.size() != 13)
+    throw std::runtime_error("hydraulic: checkpoint holds " + std::to_string(s.size()) + " scalars, expected 16");
+  cavitated_volume_ = s.size() > 13 ? s[13] : 0.0;
+  cavitated_nodes_max_ = s.size() > 13 ? long(s[14]) : 0;
+  unresolved_volume_ = s.size() > 13 ? s[15] : 0.0;
   // The pressure system as it was: assemble() builds it with the saved plate rows and rebuilds
   // the preconditioner from the values it was made from; the next solve starts from the carried Δp.
   restore_system_ = s[9] != 0;
@@ -618,7 +620,8 @@ std::vector<std::pair<std::string, double>> HydraulicPhysics::statistics() const
           {"hydraulic.boundary_inflow_volume", boundary_inflow_},
           {"hydraulic.water_removed_volume", removed_water_},
           {"hydraulic.cavitated_volume", cavitated_volume_},
-          {"hydraulic.cavitated_nodes_max", double(cavitated_nodes_max_)}};
+          {"hydraulic.cavitated_nodes_max", double(cavitated_nodes_max_)},
+          {"hydraulic.cavitation_unresolved_volume", unresolved_volume_}};
 }
 
 void HydraulicPhysics::removing_particles(const ParticleRemoval& removal) {

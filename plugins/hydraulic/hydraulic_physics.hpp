@@ -122,9 +122,9 @@ class HydraulicPhysics final : public Physics {
   FieldHandle liquid_drag_ = FieldHandle::particle("liquid_drag", 1, FieldKind::Scalar, "kg/(m^3 s)");
   FieldHandle liquid_reaction_ = FieldHandle::particle("liquid_reaction", kDim, FieldKind::Vector, "N/m^3");
   FieldHandle liquid_share_ = FieldHandle::particle("liquid_pressure_share", 1, FieldKind::Scalar, "1");
-  /// With a cavitation limit: the vapour in each particle's pores, as a share of its volume
+  /// With a cavitation limit: the vapour in each particle's pores, a volume like the particle's
   /// (written by the pressure stage; carried, checkpointed and compacted as particle state).
-  FieldHandle vapour_ = FieldHandle::particle("vapour_fraction", 1, FieldKind::Scalar, "1");
+  FieldHandle vapour_ = FieldHandle::particle("vapour_volume", 1, FieldKind::Scalar, "m^3/m");
   bool coupled_ = false;   ///< a skeleton that moves: the two-phase fractional step
   bool moving_ = false;    ///< particles move: the pressure state lives on the particles (FLIP)
   double mass_scaling_ = 1;
@@ -182,7 +182,7 @@ class HydraulicPhysics final : public Physics {
   // With a cavitation limit: the system before the elimination, from which the rows of the nodes
   // that cavitate are eliminated in turn (limit_to_cavitation())
   std::vector<double> values_free_, rhs_free_;
-  std::vector<double> node_vapour_;  ///< vapour volume at each node at the step's start (the particles', by weight)
+  std::vector<double> node_vapour_;  ///< vapour volume at each free node at the step's start (the particles', by weight)
   std::vector<double> vapour_weight_;  ///< Σ_p S_ip V_p: how a node's vapour goes back to its particles
   bool preconditioner_built_ = false;  ///< for the current system
   long iterations_after_refresh_ = 0, preconditioner_updates_ = 0;
@@ -207,6 +207,7 @@ class HydraulicPhysics final : public Physics {
   double boundary_inflow_ = 0;  ///< water volume that entered through pressure and flux boundaries
   double cavitated_volume_ = 0;  ///< vapour volume in the pores at the end of the last step [m³ per m]
   long cavitated_nodes_max_ = 0;  ///< most nodes held at the cavitation pressure in one step
+  double unresolved_volume_ = 0;  ///< vapour held nodes overdrew once releases had stopped (water made up)
   std::vector<double> saved_scalars_;
   std::vector<double> step_iterations_, step_residuals_;  ///< of every pressure solve, for run.json
 
@@ -241,7 +242,7 @@ class HydraulicPhysics final : public Physics {
   /// Replaces the rows and columns of the `held` nodes by the identity, their Δp (already set)
   /// moved to the right-hand side: A stays symmetric.
   void eliminate_rows(const std::vector<char>& held);
-  /// The particles' vapour gathered on the nodes (none on fixed ones); whether any node has some.
+  /// The particles' vapour gathered on their free nodes; whether any node has some.
   bool gather_vapour();
   /// The cavitation limit: nodes whose pressure fell below it are held there and the system
   /// solved again, until every free node is at or above it and every held node keeps vapour;

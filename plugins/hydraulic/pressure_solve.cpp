@@ -426,20 +426,23 @@ bool HydraulicPhysics::gather_vapour() {
   node_vapour_.assign(nodes, 0.0);
   vapour_weight_.assign(nodes, 0.0);
   const int K = st.per_particle();
+  // Each particle's vapour (a volume: the skeleton's own volume change is the pressure
+  // equation's, so it must not scale with V) onto its free nodes only, by weight: a fixed node
+  // (a pressure boundary, a dry or empty node) has no balance to hold it. The free nodes next to
+  // a drained boundary then draw its water in through the flow, counted as inflow there.
   kernel_->transfer().scatter([&](std::size_t q) {
     const auto* n = st.nodes(q);
     const auto* w = st.weights(q);
+    double on_free = 0;
+    for (int k = 0; k < K; ++k) on_free += fixed_[n[k]] ? 0.0 : w[k];
     for (int k = 0; k < K; ++k) {
-      node_vapour_[n[k]] += w[k] * f[q] * vol[q];
+      if (fixed_[n[k]]) continue;
+      if (f[q] > 0) node_vapour_[n[k]] += f[q] * w[k] / on_free;
       vapour_weight_[n[k]] += w[k] * vol[q];
     }
   });
-  // Fixed rows (a drained node, an empty one) lose theirs: the boundary supplies the water.
   bool any = false;
-  for (std::size_t i = 0; i < nodes; ++i) {
-    if (fixed_[i]) node_vapour_[i] = 0.0;
-    any = any || node_vapour_[i] > 0;
-  }
+  for (std::size_t i = 0; i < nodes && !any; ++i) any = node_vapour_[i] > 0;
   return any;
 }
 
@@ -449,37 +452,43 @@ bool HydraulicPhysics::gather_vapour() {
 /// free, p_i ≥ p_c, and its water fills the vapour (r_i = −V_i/Δt), or it is held at p_c and
 /// keeps V_i + Δt r_i ≥ 0 of vapour — a complementarity problem, solved by a primal–dual active
 /// set: free nodes below p_c are held, held nodes whose vapour would be used up are let go, and
-/// the system is solved again, until nothing changes. Releases stop after kReleaseRounds, so the
-/// set only grows from then on and the loop ends. Without vapour and with no node below p_c,
-/// the first solve stands.
+/// the system is solved again, until nothing changes. Releases stop after kReleaseRounds
+/// checks, so the set only grows from then on and the loop ends; a held node whose vapour is
+/// then overdrawn is counted (hydraulic.cavitation_unresolved_volume). Without vapour and with no
+/// node below p_c, the first solve stands.
 void HydraulicPhysics::limit_to_cavitation(bool vapour) {
   constexpr int kReleaseRounds = 8;
   const std::size_t nodes = fixed_.size();
   const auto& p = *p_;
   auto& dp = *dp_;
-  // Nodes with vapour start held (a free one would have to draw its vapour's volume of water
-  // through frozen ground within the step: a first solve far from the answer).
-  std::vector<char> held(nodes, 0);
-  for (std::size_t i = 0; i < nodes; ++i) held[i] = node_vapour_[i] > 0;
   // Below by more than the solve's round-off (a released node may land a hair under p_c).
   const double margin = 1e-9 * std::max(std::abs(cavitation_pressure_), 1.0);
-  for (int round = 0;; ++round) {
+  // Nodes with vapour that are at the limit start held (free, one would have to draw its
+  // vapour's volume of water through frozen ground within the step: a first solve far from the
+  // answer); vapour a node above the limit received from its particles is filled if it can be.
+  std::vector<char> held(nodes, 0);
+  for (std::size_t i = 0; i < nodes; ++i) held[i] = node_vapour_[i] > 0 && p[i] <= cavitation_pressure_ + margin;
+  const double tolerance = params_.real("linear_tolerance");
+  for (int round = 0, checks = 0;; ++round) {
     bool changed = vapour && round == 0;  // the first solve is still to come
-    for (std::size_t i = 0; i < nodes && !(vapour && round == 0); ++i) {
-      if (fixed_[i]) continue;
-      if (!held[i] && p[i] + dp[i] < cavitation_pressure_ - margin) {
-        held[i] = 1;
-        changed = true;
-      } else if (held[i] && round < kReleaseRounds && node_vapour_[i] + dt_ * unconstrained_residual(i) < 0) {
-        held[i] = 0;
-        changed = true;
+    if (!changed) {
+      for (std::size_t i = 0; i < nodes; ++i) {
+        if (fixed_[i]) continue;
+        if (!held[i] && p[i] + dp[i] < cavitation_pressure_ - margin) {
+          held[i] = 1;
+          changed = true;
+        } else if (held[i] && checks < kReleaseRounds && node_vapour_[i] + dt_ * unconstrained_residual(i) < 0) {
+          held[i] = 0;
+          changed = true;
+        }
       }
+      ++checks;
     }
     if (!changed) break;
     values_ = values_free_;
     rhs_ = rhs_free_;
     for (std::size_t i = 0; i < nodes; ++i)
-      if (!fixed_[i] && node_vapour_[i] > 0) rhs_[i] -= node_vapour_[i] / dt_;
+      if (node_vapour_[i] > 0) rhs_[i] -= node_vapour_[i] / dt_;  // a free node's water fills its vapour
     std::vector<char> rows(fixed_);
     for (std::size_t i = 0; i < nodes; ++i)
       if (held[i]) {
@@ -501,25 +510,30 @@ void HydraulicPhysics::limit_to_cavitation(bool vapour) {
       rhs_[i] -= a_x;
     });
     for (std::size_t i = 0; i < nodes; ++i) start_norm2 += rhs_[i] * rhs_[i];
-    const double tolerance = params_.real("linear_tolerance");
     std::fill(dp.begin(), dp.end(), 0.0);
-    solve_system(preconditioner_built_ ? PreconditionerUpdate::Refresh : PreconditionerUpdate::Rebuild,
-                 start_norm2 > 0 ? std::min(0.1, tolerance * std::sqrt(free_norm2 / start_norm2)) : tolerance);
+    // Not below 1e-13: a correction far smaller than the free rows' balance meets round-off first.
+    const double relative = start_norm2 > 0 ? std::clamp(tolerance * std::sqrt(free_norm2 / start_norm2), 1e-13, 0.1)
+                                            : tolerance;
+    solve_system(preconditioner_built_ ? PreconditionerUpdate::Refresh : PreconditionerUpdate::Rebuild, relative);
     for (std::size_t i = 0; i < nodes; ++i) dp[i] += start[i];
     refresh_due_ = true;  // the next step's matrix is the unconstrained one again
   }
   // The vapour at the step's end: what the held nodes keep; free nodes' water filled theirs.
-  double total = 0;
+  double total = 0, overdrawn = 0;
   long count = 0;
   for (std::size_t i = 0; i < nodes; ++i) {
-    node_vapour_[i] = held[i] ? std::max(node_vapour_[i] + dt_ * unconstrained_residual(i), 0.0) : 0.0;
+    const double kept = held[i] ? node_vapour_[i] + dt_ * unconstrained_residual(i) : 0.0;
+    overdrawn += std::min(kept, 0.0);
+    node_vapour_[i] = std::max(kept, 0.0);
     total += node_vapour_[i];
     count += held[i];
   }
   cavitated_volume_ = total;
+  unresolved_volume_ -= overdrawn;
   cavitated_nodes_max_ = std::max(cavitated_nodes_max_, count);
   // Back to the particles in proportion to S_ip V_p, so that their vapour sums to the nodes'.
   const auto& st = kernel_->transfer().stencil();
+  const auto vol = volume_.values();
   auto f = vapour_.mutable_values();
   const int K = st.per_particle();
   parallel_for(f.size(), [&](std::size_t q) {
@@ -527,7 +541,7 @@ void HydraulicPhysics::limit_to_cavitation(bool vapour) {
     const auto* w = st.weights(q);
     double share = 0;
     for (int k = 0; k < K; ++k)
-      if (vapour_weight_[n[k]] > 0) share += w[k] * node_vapour_[n[k]] / vapour_weight_[n[k]];
+      if (vapour_weight_[n[k]] > 0) share += w[k] * vol[q] * node_vapour_[n[k]] / vapour_weight_[n[k]];
     f[q] = share;
   });
 }
