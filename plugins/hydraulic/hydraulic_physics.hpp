@@ -249,7 +249,7 @@ class HydraulicPhysics final : public Physics {
   /// the nodes' new vapour goes back to the particles.
   /// `vapour`: nodes hold vapour from earlier steps, and no solve has been made yet.
   void limit_to_cavitation(bool vapour);
-  /// (A Δp − b)_i of node i's unconstrained row: the water the node takes in over Δt.
+  /// (A Δp − b)_i of node i's unconstrained row: the water the node takes in, per unit time.
   double unconstrained_residual(std::size_t i) const;
   void correct();
   void map_to_particles();
