@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "frostmpm/linalg/csr_matrix.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 #include "hydraulic_physics.hpp"
 
@@ -411,11 +412,8 @@ void HydraulicPhysics::solve_system(PreconditionerUpdate update, double toleranc
 }
 
 double HydraulicPhysics::unconstrained_residual(std::size_t i) const {
-  const auto& dp = *dp_;
-  double r = -rhs_free_[i];
-  for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e)
-    r += values_free_[e] * dp[static_cast<std::size_t>(graph_.columns[e])];
-  return r;
+  return row_dot(values_free_.data(), graph_.columns.data(), graph_.offsets[i], graph_.offsets[i + 1], dp_->data()) -
+         rhs_free_[i];
 }
 
 bool HydraulicPhysics::gather_vapour() {
@@ -504,10 +502,7 @@ void HydraulicPhysics::limit_to_cavitation(bool vapour) {
       if (!rows[i]) free_norm2 += rhs_[i] * rhs_[i];
     const std::vector<double> start(dp);
     parallel_for(nodes, [&](std::size_t i) {
-      double a_x = 0;
-      for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e)
-        a_x += values_[e] * start[static_cast<std::size_t>(graph_.columns[e])];
-      rhs_[i] -= a_x;
+      rhs_[i] -= row_dot(values_.data(), graph_.columns.data(), graph_.offsets[i], graph_.offsets[i + 1], start.data());
     });
     for (std::size_t i = 0; i < nodes; ++i) start_norm2 += rhs_[i] * rhs_[i];
     std::fill(dp.begin(), dp.end(), 0.0);
