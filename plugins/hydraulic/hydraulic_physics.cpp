@@ -271,16 +271,21 @@ void HydraulicPhysics::begin_step(double time, double dt) {
 void HydraulicPhysics::update_coefficients() {
   const auto phi = porosity_.values();
   const auto S = saturation_.values();
+  // The models in batches of a material's particles, which the threads share (models are pure
+  // functions of their inputs: each batch is evaluated on its own, the same on any thread count).
+  constexpr std::size_t kBatch = 512;
   for (const auto& r : kernel_->particle_ranges()) {
     const auto& m = materials_[r.material];
-    const std::span<const double> phi_r(phi.data() + r.begin, r.size()), S_r(S.data() + r.begin, r.size());
-    m.absolute->evaluate(phi_r, std::span<double>(k_a_.data() + r.begin, r.size()),
-                         std::span<double>(scratch_.data() + r.begin, r.size()));
-    if (m.relative)
-      m.relative->evaluate(S_r, phi_r, std::span<double>(k_r_.data() + r.begin, r.size()),
-                           std::span<double>(scratch_.data() + r.begin, r.size()));
-    else
-      std::fill(k_r_.begin() + r.begin, k_r_.begin() + r.end, 1.0);
+    parallel_chunks(r.size(), kBatch, [&](std::size_t offset, std::size_t count) {
+      const std::size_t b = r.begin + offset;
+      const std::span<const double> phi_b(phi.data() + b, count), S_b(S.data() + b, count);
+      m.absolute->evaluate(phi_b, std::span<double>(k_a_.data() + b, count), std::span<double>(scratch_.data() + b, count));
+      if (m.relative)
+        m.relative->evaluate(S_b, phi_b, std::span<double>(k_r_.data() + b, count),
+                             std::span<double>(scratch_.data() + b, count));
+      else
+        std::fill_n(k_r_.begin() + std::ptrdiff_t(b), count, 1.0);
+    });
   }
   parallel_for(kernel_->particle_count(), [&](std::size_t p) {
     const auto& m = materials_[material_[p]];

@@ -145,6 +145,11 @@ class HydraulicPhysics final : public Physics {
   // Coupled: Q, the mass balance's dependence on the skeleton's nodal velocity (Dim values per
   // entry of the graph), and its transpose; the pressure matrix holds Δt Q M⁻¹ Qᵀ
   std::vector<double> coupling_, coupling_transposed_;
+  // assemble_skeleton()'s scratch for the rigid plates: Q_g by row, rows already met, and the
+  // CSR position of each column of the row being added to
+  std::vector<double> plate_column_;
+  std::vector<char> plate_touched_;
+  std::vector<std::size_t> slot_of_;
   std::vector<double> was_active_;  ///< moving particles: nodes the material covered last step (1/0)
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
@@ -165,6 +170,10 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> cell_stabilization_;
   std::uint64_t stabilization_version_ = ~std::uint64_t{0};  ///< stencil the cell weights belong to (none yet)
   bool stabilized_ = false;
+  std::uint64_t graph_builds_ = 0;  ///< counts the pressure graph's builds (when its positions change)
+  /// Each cell's 16 CSR positions of the projection in graph_ (build graph_builds_ at the time).
+  std::vector<std::size_t> stabilization_slots_;
+  std::uint64_t stabilization_slots_graph_ = ~std::uint64_t{0};
   // The pressure-boundary nodes (each once) and their rows as assembled, before the elimination
   std::vector<std::size_t> pressure_nodes_;
   std::vector<double> condition_share_;  ///< scratch of update_pressure_nodes

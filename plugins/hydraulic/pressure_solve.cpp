@@ -15,6 +15,7 @@
 
 #include "frostmpm/linalg/csr_matrix.hpp"
 #include "frostmpm/parallel/parallel.hpp"
+#include "frostmpm/shape/shape_function.hpp"
 #include "hydraulic_physics.hpp"
 
 namespace frostmpm::hydraulic {
@@ -46,6 +47,7 @@ void HydraulicPhysics::assemble() {
       graph_.build(st, nodes);
     }
     graph_.topology_version = kernel_->transfer().topology_version();
+    ++graph_builds_;
     mobility_gram_.invalidate();
     SolverOptions options;
     options.method = params_.string("solver");
@@ -187,17 +189,27 @@ void HydraulicPhysics::assemble_skeleton() {
   const int K = st.per_particle();
   const std::size_t nodes = node_mass_.size();
   // Q in the particle-stencil pattern (compact_), Dim values per entry.
-  coupling_.assign(compact_.nonzeros() * kDim, 0.0);
-  coupling_transposed_.assign(compact_.nonzeros() * kDim, 0.0);
-  kernel_->transfer().scatter([&](std::size_t q) {
-    const auto* w = st.weights(q);
-    const auto* g = st.gradients(q);
-    const int* slot = compact_.scatter.data() + q * K * K;
-    for (int a = 0; a < K; ++a)
-      for (int b = 0; b < K; ++b)
-        for (int d = 0; d < kDim; ++d)
-          coupling_[std::size_t(slot[a * K + b]) * kDim + d] +=
-              vol[q] * (w[a] * g[b * kDim + d] + share[q] * g[a * kDim + d] * w[b]);
+  coupling_.resize(compact_.nonzeros() * kDim);
+  coupling_transposed_.resize(compact_.nonzeros() * kDim);  // every entry written below
+  parallel_for(coupling_.size(), [&](std::size_t e) { coupling_[e] = 0.0; });
+  double* coupling = coupling_.data();
+  const auto& transfer = kernel_->transfer();
+  constexpr int kWidest = kDim == 2 ? 16 : 64;  // cubic B-splines
+  for_support<kDim>(K, [&](auto support) {
+    // A fixed support (GIMP) unrolls; the contributions are formed first and then added, so that
+    // the arithmetic is not held up by stores that might alias its inputs (as the mechanical scatters).
+    transfer.scatter([&](std::size_t q) {
+      const auto* w = st.weights(q);
+      const auto* g = st.gradients(q);
+      const int* slot = compact_.scatter.data() + q * support * support;
+      double c[kWidest * kWidest * kDim];
+      for (int a = 0; a < support; ++a)
+        for (int b = 0; b < support; ++b)
+          for (int d = 0; d < kDim; ++d)
+            c[(a * support + b) * kDim + d] = vol[q] * (w[a] * g[b * kDim + d] + share[q] * g[a * kDim + d] * w[b]);
+      for (int ab = 0; ab < support * support; ++ab)
+        for (int d = 0; d < kDim; ++d) coupling[std::size_t(slot[ab]) * kDim + d] += c[ab * kDim + d];
+    });
   });
   // Qᵀ in the same (structurally symmetric) pattern: row j holds Q_kj at column k.
   parallel_for(nodes, [&](std::size_t j) {
@@ -235,20 +247,40 @@ void HydraulicPhysics::assemble_skeleton() {
     }
   }
   if (group.empty()) return;
-  // The plates: Q_g,i = Σ_{j ∈ g} Q_ij,axis over the rows that touch them; A += Δt Q_g Q_gᵀ / M_g.
-  std::map<int, std::map<std::size_t, double>> columns;  // group → row → Q_g,i
-  std::map<int, double> group_mobility;
-  for (std::size_t j = 0; j < nodes; ++j) {
-    if (!(group[j] > 0)) continue;
-    const int g = int(group[j]), d = (g - 1) % kDim;
-    group_mobility[g] = mobility[j * kDim + d];
-    for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f)
-      columns[g][std::size_t(compact_.columns[f])] += coupling_transposed_[f * kDim + d];  // Q_kj,d
-  }
-  for (const auto& [g, rows] : columns) {
-    const double factor = dt_ * group_mobility[g];
-    for (const auto& [i, qi] : rows)
-      for (const auto& [k, qk] : rows) values_[graph_.position(i, int(k))] += factor * qi * qk;
+  // The plates: Q_g,i = Σ_{j ∈ g} Q_ij,axis over the rows that touch them; A += Δt Q_g Q_gᵀ / M_g,
+  // group by group in ascending order, each Q_g,i summed over j and then over row j's entries.
+  std::vector<int> groups;
+  for (std::size_t j = 0; j < nodes; ++j)
+    if (group[j] > 0) groups.push_back(int(group[j]));
+  std::sort(groups.begin(), groups.end());
+  groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
+  plate_column_.assign(nodes, 0.0);
+  plate_touched_.assign(nodes, 0);
+  slot_of_.resize(nodes);
+  for (const int g : groups) {
+    const int d = (g - 1) % kDim;
+    double plate_mobility = 0;
+    std::vector<std::size_t> rows;
+    for (std::size_t j = 0; j < nodes; ++j) {
+      if (!(group[j] > 0) || int(group[j]) != g) continue;
+      plate_mobility = mobility[j * kDim + d];  // the same on every node of the plate
+      for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f) {
+        const auto k = std::size_t(compact_.columns[f]);
+        if (!plate_touched_[k]) rows.push_back(k);
+        plate_touched_[k] = 1;
+        plate_column_[k] += coupling_transposed_[f * kDim + d];  // Q_kj,d
+      }
+    }
+    std::sort(rows.begin(), rows.end());
+    const double factor = dt_ * plate_mobility;
+    for (const std::size_t i : rows) {
+      for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) slot_of_[std::size_t(graph_.columns[e])] = e;
+      for (const std::size_t k : rows) values_[slot_of_[k]] += factor * plate_column_[i] * plate_column_[k];
+    }
+    for (const std::size_t k : rows) {
+      plate_column_[k] = 0.0;
+      plate_touched_[k] = 0;
+    }
   }
 }
 
@@ -306,12 +338,24 @@ void HydraulicPhysics::add_stabilization() {
   const auto& grid = kernel_->grid();
   // G of a constitutive model changes with the ice: then every step.
   if (stabilization_version_ != kernel_->transfer().version() || shear_modulus_.bound()) update_cell_stabilization();
+  // Each cell's 16 entries found once per graph (a cell's slots are looked up when it first takes
+  // the projection: an empty cell's node pairs need not be in the pattern).
+  constexpr std::size_t kUnknown = ~std::size_t{0};
+  if (stabilization_slots_graph_ != graph_builds_) {
+    stabilization_slots_.assign(cell_stabilization_.size() * 16, kUnknown);
+    stabilization_slots_graph_ = graph_builds_;
+  }
   for (std::size_t c = 0; c < cell_stabilization_.size(); ++c) {
     const double w = cell_stabilization_[c] / (144.0 * dt_);
     if (w == 0) continue;
-    const auto n = cell_nodes(grid, c);
+    std::size_t* slot = stabilization_slots_.data() + 16 * c;
+    if (slot[0] == kUnknown) {
+      const auto n = cell_nodes(grid, c);
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) slot[4 * a + b] = graph_.position(n[a], static_cast<int>(n[b]));
+    }
     for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) values_[graph_.position(n[a], static_cast<int>(n[b]))] += w * kProjection[a][b];
+      for (int b = 0; b < 4; ++b) values_[slot[4 * a + b]] += w * kProjection[a][b];
   }
 }
 

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -14,22 +13,12 @@
 #include "frostmpm/io/log.hpp"
 #include "frostmpm/models/pore_space.hpp"
 #include "frostmpm/models/tensor3.hpp"
+#include "frostmpm/shape/shape_function.hpp"
 #include "frostmpm/parallel/parallel.hpp"
 
 namespace frostmpm::mechanical {
 
 namespace {
-
-/// f(std::integral_constant<int, 3^Dim>) for GIMP stencils — loops over the support of a fixed
-/// length, which the compiler unrolls — and f(K) for any other support size.
-template <int Dim, class F>
-void for_support(int K, F&& f) {
-  constexpr int gimp = Dim == 2 ? 9 : 27;
-  if (K == gimp)
-    f(std::integral_constant<int, gimp>{});
-  else
-    f(K);
-}
 
 /// update_stress()'s kinematics in plane strain — the strain increment, F ← (I + L Δt) F, the
 /// volume ratio det(I + L Δt) and the Jaumann rotation of the start stress — as the generic
@@ -95,10 +84,6 @@ void for_support(int K, F&& f) {
   }
   return true;
 }
-
-/// The most nodes a particle's support has (cubic B-splines in 3-D): the size of the per-particle
-/// buffers the scatters fill before adding into the nodes.
-constexpr int kMaxSupport = 64;
 
 }  // namespace
 
@@ -657,11 +642,7 @@ void MechanicalPhysics<Dim>::update_stress() {
     out.p_wave_modulus = {wave_modulus_.data() + r.begin, count};
     out.shear_modulus = shear_.mutable_values().subspan(r.begin, count);
     constexpr std::size_t kChunk = 512;  // small enough that a 4k-particle scene fills two threads
-    const std::size_t chunks = (count + kChunk - 1) / kChunk;
-    std::vector<std::exception_ptr> errors(chunks);  // a model that throws: the first chunk's, rethrown here
-#pragma omp parallel for schedule(static) if (chunks > 1)
-    for (std::size_t c = 0; c < chunks; ++c) {
-      const std::size_t b = c * kChunk, k = std::min(kChunk, count - b);
+    parallel_chunks(count, kChunk, [&](std::size_t b, std::size_t k) {
       auto part = [&](auto span, std::size_t width) { return span.empty() ? span : span.subspan(b * width, k * width); };
       StressUpdateInput ci = in;
       ci.strain_increment = part(in.strain_increment, 6);
@@ -676,14 +657,8 @@ void MechanicalPhysics<Dim>::update_stress() {
       co.failed = part(out.failed, 1);
       co.p_wave_modulus = part(out.p_wave_modulus, 1);
       co.shear_modulus = part(out.shear_modulus, 1);
-      try {
-        m.model->integrate(ci, co);
-      } catch (...) {
-        errors[c] = std::current_exception();
-      }
-    }
-    for (const auto& error : errors)
-      if (error) std::rethrow_exception(error);
+      m.model->integrate(ci, co);
+    });
     for (std::size_t k = 0; k < nv; ++k) {
       auto values = variables_[m.variables[k]].mutable_values();
       for (std::size_t i = 0; i < count; ++i) values[r.begin + i] = state_out_[i * nv + k];

@@ -674,7 +674,8 @@ void SparseSystem::set_values(std::span<const double> values) {
                                 std::to_string(impl_->current.values.size()) + " values, got " +
                                 std::to_string(values.size()));
   }
-  std::copy(values.begin(), values.end(), impl_->current.values.begin());
+  double* to = impl_->current.values.data();
+  parallel_for(values.size(), [&](std::size_t e) { to[e] = values[e]; });
   impl_->mark_values_changed();
 }
 

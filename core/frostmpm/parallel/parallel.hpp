@@ -5,6 +5,7 @@
 // the same on 1 or N threads. Scatters to grid nodes go through ColouredBlocks.
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <vector>
 
 #ifdef _OPENMP
@@ -32,6 +33,25 @@ template <class F>
 void parallel_for(std::size_t n, F&& f) {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
   for (std::size_t i = 0; i < n; ++i) f(i);
+}
+
+/// f(begin, count) over [0, n) cut into chunks of `chunk` indices (fixed, whatever the thread
+/// count), which the threads share: for batched model calls (one virtual call per chunk), each
+/// chunk on its own. An exception thrown by f is rethrown here, the first chunk's.
+template <class F>
+void parallel_chunks(std::size_t n, std::size_t chunk, F&& f) {
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  std::vector<std::exception_ptr> errors(chunks);
+#pragma omp parallel for schedule(static) if (chunks > 1)
+  for (std::size_t c = 0; c < chunks; ++c) {
+    try {
+      f(c * chunk, std::min(chunk, n - c * chunk));
+    } catch (...) {
+      errors[c] = std::current_exception();
+    }
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 /// Σ f(i) over [0, n), reproducible bitwise whatever the thread count: fixed chunks of 2048

@@ -35,25 +35,33 @@ class GradientGram {
     const auto& st = transfer.stencil();
     const std::size_t n = st.particles(), rows = graph.rows();
     const int K = st.per_particle();
-    if (values_.size() != graph.nonzeros() || version_ != st.version() || assembled_.size() != n) {
-      values_.assign(graph.nonzeros(), 0.0);
-      assembled_.assign(n, std::numeric_limits<double>::quiet_NaN());  // NaN ≠ anything: every row dirty
-      version_ = st.version();
-    }
-    dirty_.assign(rows, 0);
     bool any = false;
-    for (std::size_t p = 0; p < n; ++p) {
-      const double value = c(p);
-      if (value == assembled_[p]) continue;
-      assembled_[p] = value;
-      const auto* nodes = st.nodes(p);
-      for (int k = 0; k < K; ++k) dirty_[nodes[k]] = 1;
-      any = true;
+    if (values_.size() != graph.nonzeros() || version_ != st.version() || assembled_.size() != n) {
+      // A new stencil (particles that move: every step): every entry assembled anew, in parallel.
+      values_.resize(graph.nonzeros());
+      assembled_.resize(n);
+      version_ = st.version();
+      parallel_for(values_.size(), [&](std::size_t e) { values_[e] = 0.0; });
+      parallel_for(n, [&](std::size_t p) { assembled_[p] = c(p); });
+      dirty_.assign(rows, 1);
+      any = n > 0;
+    } else {
+      // The same stencil: only the rows of particles whose coefficient changed.
+      dirty_.assign(rows, 0);
+      for (std::size_t p = 0; p < n; ++p) {
+        const double value = c(p);
+        if (value == assembled_[p]) continue;
+        assembled_[p] = value;
+        const auto* nodes = st.nodes(p);
+        for (int k = 0; k < K; ++k) dirty_[nodes[k]] = 1;
+        any = true;
+      }
+      if (!any) return false;
+      parallel_for(rows, [&](std::size_t i) {
+        if (dirty_[i]) std::fill(values_.begin() + long(graph.offsets[i]), values_.begin() + long(graph.offsets[i + 1]), 0.0);
+      });
     }
     if (!any) return false;
-    parallel_for(rows, [&](std::size_t i) {
-      if (dirty_[i]) std::fill(values_.begin() + long(graph.offsets[i]), values_.begin() + long(graph.offsets[i + 1]), 0.0);
-    });
     transfer.scatter([&](std::size_t p) {
       const auto* nodes = st.nodes(p);
       bool touches = false;
