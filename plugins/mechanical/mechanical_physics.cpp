@@ -538,131 +538,148 @@ void MechanicalPhysics<Dim>::update_stress() {
     density(p, rho_m, skeleton, n_l);
     inertia[p] = mass_scaling_ * (two_phase ? skeleton : rho_m);
   };
-  for_support<Dim>(transfer.stencil().per_particle(), [&](auto support) {
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (std::size_t p = 0; p < n; ++p) {
-      const auto L = transfer.vector_gradient_at(p, vn, support);
-      double* de = strain_increment_.data() + 6 * p;
-      double* rotated = rotated_.data() + 6 * p;
-      const auto& m = materials_[transfer.material(p)];
-      // Thermal strain of the grains: β_s ΔT / 3 on each normal component (β_s is volumetric).
-      const double dT = thermal ? T[p] - previous_T_[p] : 0.0;
-      const double thermal_strain = thermal ? m.expansion * dT / 3.0 : m.expansion * 0.0;  // its signed zero as before
-      // Kinematics: Δε, F ← (I + L Δt) F, the volume ratio and the rotated start stress.
-      double J_ratio = 0;
-      bool done = false;
-      if constexpr (Dim == 2)
-        done = plane_strain_kinematics(L, dt_, F.data() + 9 * p, de, J_ratio, jaumann_, sigma_start.data() + 6 * p,
-                                       rotated);
-      if (!done) {
-        tensor3::Mat l{}, W{};
-        for (int a = 0; a < Dim; ++a)
-          for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
-        tensor3::Mat sym{};
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
-        tensor3::from_matrix(sym, de);
-        double f[9];
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) {
-            double s = F[9 * p + 3 * a + b];
-            for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
-            f[3 * a + b] = s;
-          }
-        double increment[9];
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
-        J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
-                  increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
-                  increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
-        std::copy(f, f + 9, F.data() + 9 * p);
-        std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
-        if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
-      }
-      for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
-      for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
-      if (thermal) {
-        grain_strain[p] += thermal_strain;
-        previous_T_[p] = T[p];
-      }
-      if (cell_average_) {  // the volume follows its cell's mean below (F-bar)
-        thermal_strain_[p] = thermal_strain;
-        volume_ratio_[p] = J_ratio;
-      } else {
-        close_volume(p, J_ratio, 1.0 + m.expansion * dT);
-      }
+  // Kinematics of particle p: Δε (less the grains' thermal strain) into de, the rotated start
+  // stress into rotated; F, the total strain and the grains' thermal strain updated.
+  struct Kinematics {
+    double J_ratio;          ///< the step's volume ratio det(I + L Δt)
+    double thermal_strain;   ///< β_s ΔT / 3
+    double grain_expansion;  ///< 1 + β_s ΔT
+  };
+  auto kinematics = [&](auto support, std::size_t p, double* de, double* rotated) {
+    const auto L = transfer.vector_gradient_at(p, vn, support);
+    const auto& m = materials_[transfer.material(p)];
+    // Thermal strain of the grains: β_s ΔT / 3 on each normal component (β_s is volumetric).
+    const double dT = thermal ? T[p] - previous_T_[p] : 0.0;
+    const double thermal_strain = thermal ? m.expansion * dT / 3.0 : m.expansion * 0.0;  // its signed zero as before
+    // Kinematics: Δε, F ← (I + L Δt) F, the volume ratio and the rotated start stress.
+    double J_ratio = 0;
+    bool done = false;
+    if constexpr (Dim == 2)
+      done = plane_strain_kinematics(L, dt_, F.data() + 9 * p, de, J_ratio, jaumann_, sigma_start.data() + 6 * p,
+                                     rotated);
+    if (!done) {
+      tensor3::Mat l{}, W{};
+      for (int a = 0; a < Dim; ++a)
+        for (int b = 0; b < Dim; ++b) l[a][b] = L[a][b];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) W[a][b] = 0.5 * (l[a][b] - l[b][a]);
+      tensor3::Mat sym{};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) sym[a][b] = 0.5 * (l[a][b] + l[b][a]) * dt_;
+      tensor3::from_matrix(sym, de);
+      double f[9];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          double s = F[9 * p + 3 * a + b];
+          for (int c = 0; c < 3; ++c) s += dt_ * l[a][c] * F[9 * p + 3 * c + b];
+          f[3 * a + b] = s;
+        }
+      double increment[9];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) increment[3 * a + b] = (a == b ? 1.0 : 0.0) + dt_ * l[a][b];
+      J_ratio = increment[0] * (increment[4] * increment[8] - increment[5] * increment[7]) -
+                increment[1] * (increment[3] * increment[8] - increment[5] * increment[6]) +
+                increment[2] * (increment[3] * increment[7] - increment[4] * increment[6]);
+      std::copy(f, f + 9, F.data() + 9 * p);
+      std::copy(sigma_start.data() + 6 * p, sigma_start.data() + 6 * p + 6, rotated);
+      if (jaumann_) tensor3::jaumann_rotate(W, dt_, rotated);
     }
-  });
-  if (cell_average_) {
-    average_volumetric_strain();
-    average_volume_ratio(F, close_volume);
-  }
-  if (invalid >= 0) {
+    for (int i = 0; i < 6; ++i) strain[6 * p + i] += de[i];
+    for (int i = 0; i < 3; ++i) de[i] -= thermal_strain;
+    if (thermal) {
+      grain_strain[p] += thermal_strain;
+      previous_T_[p] = T[p];
+    }
+    return Kinematics{J_ratio, thermal_strain, 1.0 + m.expansion * dT};
+  };
+
+  // The constitutive model on one chunk [b, b + k) of material m's particles, from the strain
+  // increments and rotated start stresses at de and rotated; the model's inputs and its internal
+  // variables gathered for the chunk alone.
+  auto sigma = stress_.mutable_values();
+  const auto S = saturation_.bound() ? saturation_.values() : std::span<const double>{};
+  const auto pl = pore_pressure_.bound() ? pore_pressure_.values() : std::span<const double>{};
+  const auto shear = shear_.mutable_values();
+  auto integrate_chunk = [&](const MaterialData& m, std::size_t b, std::size_t k, const double* de, const double* rotated) {
+    const std::size_t nv = m.variables.size();
+    std::vector<double> state_in(k * nv, 0.0), state_out(k * nv, 0.0), ice;
+    for (std::size_t v = 0; v < nv; ++v) {
+      const auto start = variables_start_[m.variables[v]].values();
+      for (std::size_t i = 0; i < k; ++i) state_in[i * nv + v] = start[b + i];
+    }
+    if (!S.empty()) {
+      ice.resize(k);
+      for (std::size_t i = 0; i < k; ++i) ice[i] = 1.0 - std::clamp(S[b + i], 0.0, 1.0);
+    }
+    StressUpdateInput in;
+    in.strain_increment = {de, 6 * k};
+    in.stress_start = {rotated, 6 * k};
+    in.state_start = state_in;
+    if (thermal) in.temperature = T.subspan(b, k);
+    if (!ice.empty()) in.ice_saturation = ice;
+    if (!pl.empty()) in.pore_pressure = pl.subspan(b, k);
+    in.dt = dt_;
+    StressUpdateOutput out;
+    out.stress = sigma.subspan(6 * b, 6 * k);
+    out.state = state_out;
+    out.failed = {failed_.data() + b, k};
+    out.p_wave_modulus = {wave_modulus_.data() + b, k};
+    out.shear_modulus = shear.subspan(b, k);
+    m.model->integrate(in, out);
+    for (std::size_t v = 0; v < nv; ++v) {
+      auto values = variables_[m.variables[v]].mutable_values();
+      for (std::size_t i = 0; i < k; ++i) values[b + i] = state_out[i * nv + v];
+    }
+  };
+  auto check_volumes = [&] {
+    if (invalid < 0) return;
     std::ostringstream msg;
     msg << "numerical blow-up: the skeleton at " << kernel_->describe_particle(std::size_t(invalid))
         << " was compressed or stretched beyond its solid volume (porosity would leave (0, 1)) at t = " << time_
         << " s, step " << kernel_->step() << " (dt = " << dt_ << " s); the step may be too large or the loads too high";
     throw NumericalBlowUp(msg.str());
-  }
+  };
 
-  // The constitutive models: one batch per material range, cut into fixed chunks that the
-  // threads share (every point is integrated on its own, so the chunks change no result).
-  auto sigma = stress_.mutable_values();
-  const auto S = saturation_.bound() ? saturation_.values() : std::span<const double>{};
-  const auto pl = pore_pressure_.bound() ? pore_pressure_.values() : std::span<const double>{};
-  std::vector<double> ice;
-  if (!S.empty()) {
-    ice.resize(n);
-    for (std::size_t p = 0; p < n; ++p) ice[p] = 1.0 - std::clamp(S[p], 0.0, 1.0);
-  }
+  // Chunks of 512 particles of one material, which the threads share (every point is integrated
+  // on its own, so the chunks change no result); small enough that a 4k-particle scene fills two threads.
+  constexpr std::size_t kChunk = 512;
   std::fill(failed_.begin(), failed_.end(), 0);
-  for (const auto& r : kernel_->particle_ranges()) {
-    const auto& m = materials_[r.material];
-    const std::size_t count = r.size(), nv = m.variables.size();
-    state_in_.assign(count * nv, 0.0);
-    state_out_.assign(count * nv, 0.0);
-    for (std::size_t k = 0; k < nv; ++k) {
-      const auto start = variables_start_[m.variables[k]].values();
-      for (std::size_t i = 0; i < count; ++i) state_in_[i * nv + k] = start[r.begin + i];
-    }
-    StressUpdateInput in;
-    in.strain_increment = {strain_increment_.data() + 6 * r.begin, 6 * count};
-    in.stress_start = {rotated_.data() + 6 * r.begin, 6 * count};
-    in.state_start = state_in_;
-    if (thermal) in.temperature = T.subspan(r.begin, count);
-    if (!ice.empty()) in.ice_saturation = {ice.data() + r.begin, count};
-    if (!pl.empty()) in.pore_pressure = pl.subspan(r.begin, count);
-    in.dt = dt_;
-    StressUpdateOutput out;
-    out.stress = sigma.subspan(6 * r.begin, 6 * count);
-    out.state = state_out_;
-    out.failed = {failed_.data() + r.begin, count};
-    out.p_wave_modulus = {wave_modulus_.data() + r.begin, count};
-    out.shear_modulus = shear_.mutable_values().subspan(r.begin, count);
-    constexpr std::size_t kChunk = 512;  // small enough that a 4k-particle scene fills two threads
-    parallel_chunks(count, kChunk, [&](std::size_t b, std::size_t k) {
-      auto part = [&](auto span, std::size_t width) { return span.empty() ? span : span.subspan(b * width, k * width); };
-      StressUpdateInput ci = in;
-      ci.strain_increment = part(in.strain_increment, 6);
-      ci.stress_start = part(in.stress_start, 6);
-      ci.state_start = part(in.state_start, nv);
-      ci.temperature = part(in.temperature, 1);
-      ci.ice_saturation = part(in.ice_saturation, 1);
-      ci.pore_pressure = part(in.pore_pressure, 1);
-      StressUpdateOutput co = out;
-      co.stress = part(out.stress, 6);
-      co.state = part(out.state, nv);
-      co.failed = part(out.failed, 1);
-      co.p_wave_modulus = part(out.p_wave_modulus, 1);
-      co.shear_modulus = part(out.shear_modulus, 1);
-      m.model->integrate(ci, co);
+  if (cell_average_) {
+    // The volumetric strain of each cell's mean first, then the models.
+    for_support<Dim>(transfer.stencil().per_particle(), [&](auto support) {
+      parallel_for(n, [&](std::size_t p) {
+        const Kinematics step = kinematics(support, p, strain_increment_.data() + 6 * p, rotated_.data() + 6 * p);
+        thermal_strain_[p] = step.thermal_strain;  // the volume follows its cell's mean below (F-bar)
+        volume_ratio_[p] = step.J_ratio;
+      });
     });
-    for (std::size_t k = 0; k < nv; ++k) {
-      auto values = variables_[m.variables[k]].mutable_values();
-      for (std::size_t i = 0; i < count; ++i) values[r.begin + i] = state_out_[i * nv + k];
-    }
+    average_volumetric_strain();
+    average_volume_ratio(F, close_volume);
+    check_volumes();
+    for (const auto& r : kernel_->particle_ranges())
+      parallel_chunks(r.size(), kChunk, [&](std::size_t offset, std::size_t k) {
+        const std::size_t b = r.begin + offset;
+        integrate_chunk(materials_[r.material], b, k, strain_increment_.data() + 6 * b, rotated_.data() + 6 * b);
+      });
+  } else {
+    // Kinematics and model chunk by chunk: the strain increments and rotated stresses stay in
+    // the chunk's own buffers (in cache) between the two.
+    for_support<Dim>(transfer.stencil().per_particle(), [&](auto support) {
+      for (const auto& r : kernel_->particle_ranges()) {
+        const auto& m = materials_[r.material];
+        parallel_chunks(r.size(), kChunk, [&](std::size_t offset, std::size_t k) {
+          const std::size_t b = r.begin + offset;
+          std::vector<double> de(6 * k), rotated(6 * k);
+          for (std::size_t i = 0; i < k; ++i) {
+            const std::size_t p = b + i;
+            const Kinematics step = kinematics(support, p, de.data() + 6 * i, rotated.data() + 6 * i);
+            close_volume(p, step.J_ratio, step.grain_expansion);
+          }
+          integrate_chunk(m, b, k, de.data(), rotated.data());
+        });
+      }
+    });
+    check_volumes();
   }
   if (const auto first = std::find_if(failed_.begin(), failed_.end(), [](std::uint8_t f) { return f != 0; });
       first != failed_.end())
