@@ -12,6 +12,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "frostmpm/linalg/csr_matrix.hpp"
 #include "frostmpm/parallel/parallel.hpp"
@@ -275,7 +277,13 @@ void HydraulicPhysics::assemble_skeleton() {
     const double factor = dt_ * plate_mobility;
     for (const std::size_t i : rows) {
       for (std::size_t e = graph_.offsets[i]; e < graph_.offsets[i + 1]; ++e) slot_of_[std::size_t(graph_.columns[e])] = e;
-      for (const std::size_t k : rows) values_[slot_of_[k]] += factor * plate_column_[i] * plate_column_[k];
+      for (const std::size_t k : rows) {
+        const std::size_t e = slot_of_[k];  // stale unless row i holds column k
+        if (e < graph_.offsets[i] || e >= graph_.offsets[i + 1] || std::size_t(graph_.columns[e]) != k)
+          throw std::logic_error("pressure graph: rows " + std::to_string(i) + " and " + std::to_string(k) +
+                                 " of a rigid plate are not coupled in the graph built at the start");
+        values_[e] += factor * plate_column_[i] * plate_column_[k];
+      }
     }
     for (const std::size_t k : rows) {
       plate_column_[k] = 0.0;
