@@ -28,7 +28,8 @@ class GradientGram {
   void invalidate() { assembled_.clear(); }
 
   /// Brings values() to Σ_p c(p) ∇S_ip·∇S_jp for the transfer's current stencil in `graph`
-  /// (whose scatter map must be current). c(p) is evaluated once per particle per call.
+  /// (whose scatter map must be current). c(p) is evaluated once per particle per call, on a new
+  /// stencil by several threads at once (it must only read).
   /// Returns whether any entry changed.
   template <class Coefficient>
   bool update(const Transfer<Dim>& transfer, const StencilGraph& graph, Coefficient&& c) {
