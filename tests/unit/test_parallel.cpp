@@ -1,9 +1,13 @@
 // Parallel loops: coloured P2G scatter is race-free and bitwise independent of the thread count;
-// reproducible sums do not depend on the thread count either.
+// reproducible sums do not depend on the thread count either, nor do parallel_chunks' chunks.
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <omp.h>
 
@@ -117,4 +121,37 @@ TEST_CASE("reproducible_sum is bitwise identical on any thread count", "[paralle
   }
   omp_set_num_threads(1);
   REQUIRE(parallel_max(n, f, -1e300) >= f(1570));
+}
+
+TEST_CASE("parallel_chunks covers the range once in fixed chunks and rethrows the first chunk's error",
+          "[parallel]") {
+  const std::size_t n = 5 * 512 + 7;
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    std::vector<int> seen(n, 0);
+    std::vector<std::size_t> firsts(6, 0), counts(6, 0);
+    parallel_chunks(n, 512, [&](std::size_t begin, std::size_t count) {
+      firsts[begin / 512] = begin;
+      counts[begin / 512] = count;
+      for (std::size_t i = begin; i < begin + count; ++i) ++seen[i];
+    });
+    REQUIRE(std::count(seen.begin(), seen.end(), 1) == long(n));
+    for (std::size_t c = 0; c < 6; ++c) {
+      REQUIRE(firsts[c] == 512 * c);  // the same chunks whatever the thread count
+      REQUIRE(counts[c] == (c < 5 ? 512 : 7));
+    }
+    // Chunks 2 and 4 fail: the error of chunk 2 comes back, whichever thread met it first.
+    try {
+      parallel_chunks(n, 512, [&](std::size_t begin, std::size_t) {
+        if (begin == 2 * 512 || begin == 4 * 512) throw std::runtime_error("chunk " + std::to_string(begin / 512));
+      });
+      FAIL("no exception");
+    } catch (const std::runtime_error& e) {
+      REQUIRE(std::string(e.what()) == "chunk 2");
+    }
+  }
+  omp_set_num_threads(1);
+  int calls = 0;
+  parallel_chunks(0, 512, [&](std::size_t, std::size_t) { ++calls; });
+  REQUIRE(calls == 0);
 }
