@@ -148,7 +148,7 @@ class MechanicalPhysics final : public Physics {
   std::vector<FieldHandle> variables_, variables_start_;    ///< their particle fields
 
   // ---- per particle (scratch and the step's moduli)
-  std::vector<double> strain_increment_, rotated_, state_in_, state_out_, wave_modulus_, previous_T_;
+  std::vector<double> strain_increment_, rotated_, wave_modulus_, previous_T_;
   std::vector<double> particle_mass_;  ///< without pore-water flow: each particle's constant mass
   std::vector<std::uint8_t> failed_;
   // ---- cell-averaged volumetric strain (only with cell_average_)
