@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -26,6 +27,27 @@ void HydraulicPhysics::assemble() {
   const auto& st = kernel_->transfer().stencil();
   const auto vol = volume_.values();
   const std::size_t nodes = node_mass_.size();
+  // A rigid plate's nodes change as it moves (and as nodes gain or lose mass), and with them the
+  // rows it couples as one body: when they leave the graph's plate rows, the graph is built anew
+  // with the union of both (it only grows), so that every pair the plate term adds to is in it.
+  bool plates_outgrown = false;
+  std::vector<std::vector<std::size_t>> plate_rows;
+  if (coupled_ && system_ && !restore_system_) {
+    plate_rows = group_rows();
+    for (std::size_t g = 0; g < plate_rows.size() && !plates_outgrown; ++g)
+      plates_outgrown = g >= graph_groups_.size() || !std::includes(graph_groups_[g].begin(), graph_groups_[g].end(),
+                                                                   plate_rows[g].begin(), plate_rows[g].end());
+    if (plates_outgrown) {
+      graph_groups_.resize(std::max(graph_groups_.size(), plate_rows.size()));
+      for (std::size_t g = 0; g < plate_rows.size(); ++g) {
+        std::vector<std::size_t> both;
+        std::set_union(graph_groups_[g].begin(), graph_groups_[g].end(), plate_rows[g].begin(), plate_rows[g].end(),
+                       std::back_inserter(both));
+        graph_groups_[g] = std::move(both);
+      }
+      system_.reset();  // rebuilt below, with a new preconditioner
+    }
+  }
   if (coupled_ && system_ && graph_.topology_version != kernel_->transfer().topology_version()) {
     // Particles moved into other stencils: the lattice patterns stay, only their map from
     // particle pairs to entries changes.
@@ -40,7 +62,7 @@ void HydraulicPhysics::assemble() {
       // stencils apart (Q M⁻¹ Qᵀ), and every node near a rigid plate with every other (the plate
       // moves as one body); Q itself one stencil apart.
       const int reach = support_width(st.kind()) - 1;
-      if (!restore_system_) graph_groups_ = group_rows();
+      if (!restore_system_ && !plates_outgrown) graph_groups_ = group_rows();
       graph_.build_lattice(kernel_->grid(), 2 * reach, graph_groups_);
       graph_.build_scatter(st);
       compact_.build_lattice(kernel_->grid(), reach);
