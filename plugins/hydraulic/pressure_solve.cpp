@@ -32,7 +32,7 @@ void HydraulicPhysics::assemble() {
   // with the union of both (it only grows), so that every pair the plate term adds to is in it.
   bool plates_outgrown = false;
   std::vector<std::vector<std::size_t>> plate_rows;
-  if (coupled_ && system_ && !restore_system_) {
+  if (coupled_ && (system_ || restore_system_)) {  // after a restart: against the checkpoint's rows
     plate_rows = group_rows();
     for (std::size_t g = 0; g < plate_rows.size() && !plates_outgrown; ++g)
       plates_outgrown = g >= graph_groups_.size() || !std::includes(graph_groups_[g].begin(), graph_groups_[g].end(),
@@ -79,7 +79,11 @@ void HydraulicPhysics::assemble() {
     options.tolerance = params_.real("linear_tolerance");
     options.max_iterations = static_cast<int>(params_.integer("max_linear_iterations"));
     system_ = std::make_unique<SparseSystem>(graph_.offsets, graph_.columns, options);
-    if (restore_system_) {  // a restart: the preconditioner the checkpointed run had (its flags came back)
+    if (restore_system_ && plates_outgrown) {  // a restart at the step the straight run rebuilt
+      restore_system_ = false;
+      saved_source_ = {};
+      preconditioner_built_ = false;
+    } else if (restore_system_) {  // a restart: the preconditioner the checkpointed run had (its flags came back)
       system_->restore_preconditioner(saved_source_);
       restore_system_ = false;
       saved_source_ = {};
