@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -202,4 +203,49 @@ TEST_CASE("CG refuses an indefinite matrix", "[linalg]") {
   A.values = {1.0, -1.0};
   std::vector<double> b{1.0, 1.0}, x{0.0, 0.0};
   REQUIRE_THROWS_AS(conjugate_gradient(A, nullptr, b, x, 1e-10, 10), std::runtime_error);
+}
+
+TEST_CASE("row_dot_until gives row_dot's bits when the terms it leaves out are zero", "[linalg]") {
+  // Rows of every length up to 13 (whole groups of four, a tail, both) cut at every position:
+  // the values past the cut multiply x = 0 (of either sign), which row_dot adds and
+  // row_dot_until does not read.
+  for (std::size_t length = 0; length <= 13; ++length)
+    for (std::size_t stop = 0; stop <= length; ++stop) {
+      std::vector<double> values(length), x(length);
+      std::vector<int> columns(length);
+      for (std::size_t k = 0; k < length; ++k) {
+        values[k] = std::sin(1.7 * double(k) + 0.3 * double(length)) * 1e3;
+        columns[k] = int((k * 7 + 3) % length);  // any order
+      }
+      for (std::size_t k = 0; k < length; ++k)
+        x[std::size_t(columns[k])] = k < stop ? std::cos(0.9 * double(k)) : (k % 2 ? -0.0 : 0.0);
+      const double full = frostmpm::row_dot(values.data(), columns.data(), 0, length, x.data());
+      const double cut = frostmpm::row_dot_until(values.data(), columns.data(), 0, length, stop, x.data());
+      INFO("length " << length << ", stop " << stop);
+      REQUIRE(std::memcmp(&full, &cut, sizeof full) == 0);
+    }
+}
+
+TEST_CASE("A refreshed V-cycle is the cycle built from the new values, bit for bit", "[linalg]") {
+  const int m = 96;  // three smoother blocks on the finest level
+  CsrMatrix A = jump_matrix(m);
+  const CsrMatrix P0 = aggregation(m), P1 = aggregation(m / 2);
+  MultigridCycle cycle({A, galerkin(A, P0), galerkin(galerkin(A, P0), P1)}, {P0, P1});
+  // New values on the same patterns: the jump moved by scaling every other row's couplings.
+  for (std::size_t i = 0; i < A.rows; ++i)
+    for (std::size_t k = A.offsets[i]; k < A.offsets[i + 1]; ++k) A.values[k] *= 1.0 + 0.25 * std::sin(double(i + std::size_t(A.columns[k])));
+  const CsrMatrix A1 = galerkin(A, P0), A2 = galerkin(A1, P1);
+  const CsrMatrix* levels[] = {&A, &A1, &A2};
+  cycle.refresh(levels);
+  MultigridCycle fresh({A, A1, A2}, {P0, P1});
+  const auto u = wiggly(A.rows, 0.4);
+  std::vector<double> refreshed(A.rows), built(A.rows);
+  cycle.apply(u, refreshed);
+  fresh.apply(u, built);
+  REQUIRE(refreshed == built);  // bitwise
+
+  const CsrMatrix* too_few[] = {&A, &A1};
+  REQUIRE_THROWS_AS(cycle.refresh(too_few), std::invalid_argument);
+  const CsrMatrix* wrong_level[] = {&A, &A2, &A1};
+  REQUIRE_THROWS_AS(cycle.refresh(wrong_level), std::invalid_argument);
 }

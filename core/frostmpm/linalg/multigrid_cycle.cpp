@@ -41,50 +41,86 @@ MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<Csr
     // Equal blocks, so that 2, 4 or 8 threads share the sweep evenly.
     const std::size_t blocks = std::max<std::size_t>(1, (n + kSmootherBlockRows - 1) / kSmootherBlockRows);
     level.block_rows = std::max<std::size_t>(1, (n + blocks - 1) / blocks);
-    // Each row's own-block columns first (a stable partition: the row's sums keep one order),
-    // and the l1-enlarged diagonal a_ii + Σ |a_ij| over the columns outside the block.
-    level.inverse_l1_diagonal.assign(n, 0.0);
+    // Each row's own-block columns first (a stable partition: the row's sums keep one order);
+    // `source` remembers where each stored entry came from, so that a refresh only moves values.
     level.in_block_end.assign(n, 0);
+    level.lower_end.assign(n, 0);
     auto& A = level.A;
-    std::vector<std::pair<int, double>> outside;
+    level.source.resize(A.nonzeros());
+    const CsrMatrix given = A;  // as handed in; A's entries are reordered below
+    std::vector<std::size_t> outside;
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t block_begin = i / level.block_rows * level.block_rows;
       const std::size_t block_end = std::min(n, block_begin + level.block_rows);
-      double d = 0;
       std::size_t inside = A.offsets[i];
       outside.clear();
       for (std::size_t k = A.offsets[i]; k < A.offsets[i + 1]; ++k) {
-        const auto j = std::size_t(A.columns[k]);
-        if (j >= block_begin && j < block_end) {
-          if (j == i) d += A.values[k];
-          A.columns[inside] = A.columns[k];
-          A.values[inside++] = A.values[k];
-        } else {
-          d += std::abs(A.values[k]);
-          outside.emplace_back(A.columns[k], A.values[k]);
-        }
+        const auto j = std::size_t(given.columns[k]);
+        if (j >= block_begin && j < block_end)
+          level.source[inside++] = k;
+        else
+          outside.push_back(k);
       }
       level.in_block_end[i] = inside;
-      for (const auto& [column, value] : outside) {
-        A.columns[inside] = column;
-        A.values[inside++] = value;
-      }
-      level.inverse_l1_diagonal[i] = d != 0 ? 1.0 / d : 0.0;
+      for (const std::size_t k : outside) level.source[inside++] = k;
+      for (std::size_t q = A.offsets[i]; q < A.offsets[i + 1]; ++q) A.columns[q] = given.columns[level.source[q]];
+      level.lower_end[i] = A.offsets[i];
+      for (std::size_t q = A.offsets[i]; q < level.in_block_end[i]; ++q)
+        if (std::size_t(A.columns[q]) < i) level.lower_end[i] = q + 1;
     }
+    load_values(level, given);
     for (auto* v : {&level.x, &level.b, &level.r, &level.previous}) v->assign(n, 0.0);
   }
-  const Level& coarsest = levels_.back();
   // A single level small enough is solved directly too: MueLu makes no coarser level for a
   // matrix at or below its coarse size, which its own cycle then solved exactly.
-  coarse_direct_ = coarsest.A.rows <= kDirectCoarseRows;
-  if (coarse_direct_) {
-    const std::size_t n = coarsest.A.rows;
-    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n));
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = coarsest.A.offsets[i]; k < coarsest.A.offsets[i + 1]; ++k)
-        dense(Eigen::Index(i), coarsest.A.columns[k]) += coarsest.A.values[k];
-    coarse_.compute(dense);
+  coarse_direct_ = levels_.back().A.rows <= kDirectCoarseRows;
+  factorise_coarsest();
+}
+
+void MultigridCycle::load_values(Level& level, const CsrMatrix& given) {
+  auto& A = level.A;
+  const std::size_t n = A.rows;
+  level.inverse_l1_diagonal.resize(n);
+  parallel_for(n, [&](std::size_t i) {
+    const std::size_t block_begin = i / level.block_rows * level.block_rows;
+    const std::size_t block_end = std::min(n, block_begin + level.block_rows);
+    // The l1-enlarged diagonal a_ii + Σ |a_ij| over the columns outside the row's block.
+    double d = 0;
+    for (std::size_t k = given.offsets[i]; k < given.offsets[i + 1]; ++k) {
+      const auto j = std::size_t(given.columns[k]);
+      if (j < block_begin || j >= block_end)
+        d += std::abs(given.values[k]);
+      else if (j == i)
+        d += given.values[k];
+    }
+    level.inverse_l1_diagonal[i] = d != 0 ? 1.0 / d : 0.0;
+    for (std::size_t q = A.offsets[i]; q < A.offsets[i + 1]; ++q) A.values[q] = given.values[level.source[q]];
+  });
+}
+
+void MultigridCycle::factorise_coarsest() {
+  if (!coarse_direct_) return;
+  const Level& coarsest = levels_.back();
+  const std::size_t n = coarsest.A.rows;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(Eigen::Index(n), Eigen::Index(n));
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = coarsest.A.offsets[i]; k < coarsest.A.offsets[i + 1]; ++k)
+      dense(Eigen::Index(i), coarsest.A.columns[k]) += coarsest.A.values[k];
+  coarse_.compute(dense);
+}
+
+void MultigridCycle::refresh(std::span<const CsrMatrix* const> operators) {
+  if (operators.size() != levels_.size())
+    throw std::invalid_argument("MultigridCycle::refresh: " + std::to_string(operators.size()) + " operators for " +
+                                std::to_string(levels_.size()) + " levels");
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    const CsrMatrix& given = *operators[l];
+    if (given.rows != levels_[l].A.rows || given.nonzeros() != levels_[l].A.nonzeros())
+      throw std::invalid_argument("MultigridCycle::refresh: operator " + std::to_string(l) +
+                                  " does not have the pattern the cycle was built with");
+    load_values(levels_[l], given);
   }
+  factorise_coarsest();
 }
 
 void MultigridCycle::apply(std::span<const double> r, std::span<double> z) {
@@ -120,7 +156,8 @@ void MultigridCycle::cycle(std::size_t l) {
 void MultigridCycle::sweep(Level& level, bool forward) {
   const std::size_t n = level.A.rows;
   const std::size_t blocks = (n + level.block_rows - 1) / level.block_rows;
-  if (blocks > 1) std::copy(level.x.begin(), level.x.end(), level.previous.begin());
+  // Backward: the other blocks' values as the sweep found them. Forward (from x = 0) they are 0.
+  if (blocks > 1 && !forward) std::copy(level.x.begin(), level.x.end(), level.previous.begin());
   const auto& A = level.A;
   double* x = level.x.data();
   const double* previous = level.previous.data();
@@ -129,18 +166,26 @@ void MultigridCycle::sweep(Level& level, bool forward) {
   const double* values = A.values.data();
   const int* columns = A.columns.data();
   const std::size_t* in_block_end = level.in_block_end.data();
+  const std::size_t* lower_end = level.lower_end.data();
+  // From x = 0 (forward) only the own block's columns below the diagonal hold values yet, and
+  // the other blocks' sum (the previous sweep's values, all 0) is +0: the same bits as the full
+  // rows, with about half of the matrix read.
+  auto relax_forward = [&](std::size_t i) {
+    const double own = row_dot_until(values, columns, A.offsets[i], in_block_end[i], lower_end[i], x);
+    x[i] += (b[i] - own - 0.0) * inverse[i];
+  };
+  auto relax_backward = [&](std::size_t i) {
+    const double own = row_dot(values, columns, A.offsets[i], in_block_end[i], x);
+    const double others = row_dot(values, columns, in_block_end[i], A.offsets[i + 1], previous);
+    x[i] += (b[i] - own - others) * inverse[i];
+  };
 #pragma omp parallel for schedule(static) if (blocks > 1)
   for (std::size_t block = 0; block < blocks; ++block) {
     const std::size_t begin = block * level.block_rows, end = std::min(n, begin + level.block_rows);
-    auto relax = [&](std::size_t i) {
-      const double own = row_dot(values, columns, A.offsets[i], in_block_end[i], x);
-      const double others = row_dot(values, columns, in_block_end[i], A.offsets[i + 1], previous);
-      x[i] += (b[i] - own - others) * inverse[i];
-    };
     if (forward)
-      for (std::size_t i = begin; i < end; ++i) relax(i);
+      for (std::size_t i = begin; i < end; ++i) relax_forward(i);
     else
-      for (std::size_t i = end; i-- > begin;) relax(i);
+      for (std::size_t i = end; i-- > begin;) relax_backward(i);
   }
 }
 

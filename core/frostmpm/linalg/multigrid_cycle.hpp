@@ -35,6 +35,12 @@ class MultigridCycle final : public LinearPreconditioner {
   MultigridCycle(std::vector<CsrMatrix> operators, std::vector<CsrMatrix> prolongators,
                  std::vector<CsrMatrix> restrictions = {});
 
+  /// New values on the same patterns: operators[l] has the pattern (entries in the same order)
+  /// of the l-th operator the cycle was built with. The same cycle, bit for bit, as one built
+  /// from these operators, without its allocations and reordering. Throws std::invalid_argument
+  /// when the count or a level's size does not fit.
+  void refresh(std::span<const CsrMatrix* const> operators);
+
   /// z = one V-cycle applied to r from a zero guess.
   void apply(std::span<const double> r, std::span<double> z) override;
   std::size_t levels() const { return levels_.size(); }
@@ -45,10 +51,18 @@ class MultigridCycle final : public LinearPreconditioner {
     std::size_t block_rows = 0;  ///< rows per smoother block (the last may hold fewer)
     /// Each row of A holds its block's columns first; they end here (the rest lie in other blocks).
     std::vector<std::size_t> in_block_end;
+    /// Just past the row's last own-block column below the diagonal: a sweep from x = 0 reads
+    /// nothing beyond it (every later column, and every other block's, still holds 0).
+    std::vector<std::size_t> lower_end;
+    std::vector<std::size_t> source;  ///< stored entry -> its position in the operator as given
     std::vector<double> inverse_l1_diagonal;
     std::vector<double> x, b, r, previous;
   };
+  /// A's values and the l1 diagonal from `given` (the operator in its given entry order).
+  static void load_values(Level& level, const CsrMatrix& given);
+  void factorise_coarsest();
   void cycle(std::size_t l);
+  /// forward from x = 0 (the cycle's first sweep on each level) or backward from the current x.
   void sweep(Level& level, bool forward);
   std::vector<Level> levels_;
   Eigen::LDLT<Eigen::MatrixXd> coarse_;

@@ -193,6 +193,9 @@ struct SparseSystem::Impl {
   std::unique_ptr<LinearPreconditioner> own_preconditioner;
   /// Multigrid: the build's prolongators and the patterns of their coarse operators, finest first.
   std::vector<GalerkinProduct> galerkin;
+  /// The cycle's coarse levels have the products' patterns (it was made by a refresh), so a
+  /// refresh can load new values into it; a build's cycle holds MueLu's coarse operators.
+  bool cycle_on_products = false;
   struct {
     std::vector<double> residual;
     ConjugateGradientWork cg;
@@ -399,17 +402,32 @@ struct SparseSystem::Impl {
       own_preconditioner = std::make_unique<JacobiPreconditioner>(std::move(diagonal));
       record_source(refresh);
     } else if (kind == "multigrid") {
-      std::vector<CsrMatrix> operators{current}, prolongators, restrictions;
       if (refresh && !muelu.is_null()) {
         // New values on the build's prolongators (what MueLu's "RP" reuse keeps), the coarse
         // operators Pᵀ A P by our own threaded product (MueLu's reuse computes them serially).
-        for (const auto& product : galerkin) {
-          operators.push_back(product(operators.back()));
-          prolongators.push_back(product.prolongator());
-          restrictions.push_back(product.restriction());  // transposed once per build, not per refresh
+        std::vector<CsrMatrix> coarse;
+        coarse.reserve(galerkin.size());  // `operators` points into it
+        std::vector<const CsrMatrix*> operators{&current};
+        for (const auto& product : galerkin) operators.push_back(&coarse.emplace_back(product(*operators.back())));
+        if (cycle_on_products) {
+          // The cycle's levels have these patterns already: the values moved in place.
+          static_cast<MultigridCycle&>(*own_preconditioner).refresh(operators);
+        } else {
+          // The build's cycle holds MueLu's coarse operators, whose patterns differ: a cycle on
+          // the products' patterns, which later refreshes fill in place.
+          std::vector<CsrMatrix> levels{current}, prolongators, restrictions;
+          for (std::size_t l = 0; l < galerkin.size(); ++l) {
+            levels.push_back(std::move(coarse[l]));
+            prolongators.push_back(galerkin[l].prolongator());
+            restrictions.push_back(galerkin[l].restriction());  // transposed once per build, not per refresh
+          }
+          own_preconditioner = std::make_unique<MultigridCycle>(std::move(levels), std::move(prolongators),
+                                                                std::move(restrictions));
+          cycle_on_products = true;
         }
         record_source(true);
       } else {
+        std::vector<CsrMatrix> operators{current}, prolongators;
         upload_values(*preconditioner_matrix);  // MueLu's input, straight from `current`
         build_muelu(false);
         extract_hierarchy(operators, prolongators);
@@ -417,9 +435,9 @@ struct SparseSystem::Impl {
         galerkin.reserve(prolongators.size());  // `pattern` points into it
         const CsrMatrix* pattern = &current;
         for (const auto& P : prolongators) pattern = &galerkin.emplace_back(*pattern, P).coarse_pattern();
+        own_preconditioner = std::make_unique<MultigridCycle>(std::move(operators), std::move(prolongators));
+        cycle_on_products = false;
       }
-      own_preconditioner =
-          std::make_unique<MultigridCycle>(std::move(operators), std::move(prolongators), std::move(restrictions));
     }
     have_preconditioner = true;
   }
