@@ -115,7 +115,7 @@ void MultigridCycle::refresh(std::span<const CsrMatrix* const> operators) {
                                 std::to_string(levels_.size()) + " levels");
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     const CsrMatrix& given = *operators[l];
-    if (given.rows != levels_[l].A.rows || given.nonzeros() != levels_[l].A.nonzeros())
+    if (given.rows != levels_[l].A.rows || given.offsets != levels_[l].A.offsets)
       throw std::invalid_argument("MultigridCycle::refresh: operator " + std::to_string(l) +
                                   " does not have the pattern the cycle was built with");
     load_values(levels_[l], given);

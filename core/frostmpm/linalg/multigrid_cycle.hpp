@@ -38,7 +38,7 @@ class MultigridCycle final : public LinearPreconditioner {
   /// New values on the same patterns: operators[l] has the pattern (entries in the same order)
   /// of the l-th operator the cycle was built with. The same cycle, bit for bit, as one built
   /// from these operators, without its allocations and reordering. Throws std::invalid_argument
-  /// when the count or a level's size does not fit.
+  /// when the count or a level's rows do not fit (row lengths are checked, columns are not).
   void refresh(std::span<const CsrMatrix* const> operators);
 
   /// z = one V-cycle applied to r from a zero guess.
