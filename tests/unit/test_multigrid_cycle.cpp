@@ -219,7 +219,16 @@ TEST_CASE("row_dot_until gives row_dot's bits when the terms it leaves out are z
       }
       for (std::size_t k = 0; k < length; ++k)
         x[std::size_t(columns[k])] = k < stop ? std::cos(0.9 * double(k)) : (k % 2 ? -0.0 : 0.0);
+      // Four interleaved partial sums, the leftover terms in the first: the order every product
+      // of the project's matrices has always summed in.
+      double s[4] = {0, 0, 0, 0};
+      std::size_t k = 0;
+      for (; k + 4 <= length; k += 4)
+        for (std::size_t lane = 0; lane < 4; ++lane) s[lane] += values[k + lane] * x[std::size_t(columns[k + lane])];
+      for (; k < length; ++k) s[0] += values[k] * x[std::size_t(columns[k])];
+      const double reference = (s[0] + s[1]) + (s[2] + s[3]);
       const double full = frostmpm::row_dot(values.data(), columns.data(), 0, length, x.data());
+      REQUIRE(std::memcmp(&full, &reference, sizeof full) == 0);
       const double cut = frostmpm::row_dot_until(values.data(), columns.data(), 0, length, stop, x.data());
       INFO("length " << length << ", stop " << stop);
       REQUIRE(std::memcmp(&full, &cut, sizeof full) == 0);

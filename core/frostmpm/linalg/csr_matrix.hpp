@@ -9,27 +9,12 @@
 
 namespace frostmpm {
 
-/// Σ values[k] x[columns[k]] over [begin, end) in four interleaved partial sums: one running sum
-/// is a chain of dependent multiply–adds (4 cycles each), which the Gauss–Seidel sweep, whose
-/// next row waits for this one, cannot hide; four chains run at the memory's pace.
-inline double row_dot(const double* values, const int* columns, std::size_t begin, std::size_t end,
-                      const double* x) {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  std::size_t k = begin;
-  for (; k + 4 <= end; k += 4) {
-    s0 += values[k] * x[columns[k]];
-    s1 += values[k + 1] * x[columns[k + 1]];
-    s2 += values[k + 2] * x[columns[k + 2]];
-    s3 += values[k + 3] * x[columns[k + 3]];
-  }
-  for (; k < end; ++k) s0 += values[k] * x[columns[k]];
-  return (s0 + s1) + (s2 + s3);
-}
-
-/// row_dot(values, columns, begin, end, x) with the terms from position `stop` on left out, each
-/// other term in the partial sum row_dot gives it: bitwise row_dot's result when the terms left
-/// out are ±0 (an addend ±0 leaves a sum that started from +0 unchanged). For x that is zero at
-/// the columns of a row's tail, which then need not be read.
+/// Σ values[k] x[columns[k]] over [begin, min(stop, end)) in four interleaved partial sums, each
+/// term in the sum it would take over [begin, end): one running sum is a chain of dependent
+/// multiply–adds (4 cycles each), which the Gauss–Seidel sweep, whose next row waits for this one,
+/// cannot hide; four chains run at the memory's pace. With stop < end it is bitwise the sum over
+/// [begin, end) when the terms from stop on are ±0 (an addend ±0 leaves a sum that started from
+/// +0 unchanged): for an x that is zero at the columns of a row's tail, which need not be read.
 inline double row_dot_until(const double* values, const int* columns, std::size_t begin, std::size_t end,
                             std::size_t stop, const double* x) {
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
@@ -49,6 +34,12 @@ inline double row_dot_until(const double* values, const int* columns, std::size_
   }
   for (k = groups_end; k < std::min(stop, end); ++k) s0 += values[k] * x[columns[k]];
   return (s0 + s1) + (s2 + s3);
+}
+
+/// row_dot_until over the whole of [begin, end).
+inline double row_dot(const double* values, const int* columns, std::size_t begin, std::size_t end,
+                      const double* x) {
+  return row_dot_until(values, columns, begin, end, end, x);
 }
 
 struct CsrMatrix {
