@@ -1009,54 +1009,55 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   const auto shear = shear_.values();
   // The stable step h / max(c + |v|): the fastest signal, divided into h once (rounded division
   // is monotone, so this is min_p h / (c + |v|)_p to the bit).
-  // The energies are summed per fixed chunk of particles and the chunks' sums in order, so that
-  // they (run.json's counters) do not depend on the thread count, as an OpenMP reduction's would.
-  constexpr std::size_t kEnergyChunk = 2048;
-  const std::size_t chunks = (n + kEnergyChunk - 1) / kEnergyChunk;
-  std::vector<double> kinetic_part(chunks, 0.0), elastic_part(chunks, 0.0);
-  double fastest = 0;
+  // The energies are an ordered chunk reduction, so that they (run.json's counters) do not depend
+  // on the thread count, as an OpenMP reduction's would.
+  struct StepSums {
+    double kinetic = 0, elastic = 0, fastest = 0;
+  };
+  StepSums sums;
   auto update = [&](auto support, auto with_trapezoid) {
     constexpr bool trapezoid = decltype(with_trapezoid)::value;
-#pragma omp parallel for schedule(static) reduction(max : fastest) if (n >= kParallelMinimum)
-    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-      double kinetic = 0, elastic = 0;
-      for (std::size_t p = chunk * kEnergyChunk; p < std::min(n, (chunk + 1) * kEnergyChunk); ++p) {
-        elastic += vol[p] * elastic_energy_density(sigma.data() + 6 * p, wave_modulus_[p], shear[p]);
-        const auto* nodes = st.nodes(p);
-        const auto* w = st.weights(p);
-        std::array<double, Dim> dv{}, pic{}, move{};
-        for (int a = 0; a < support; ++a) {
-          const std::size_t i = nodes[a];
-          for (int d = 0; d < Dim; ++d) {
-            // FLIP increment from the mapped velocity.
-            dv[d] += w[a] * (vi[i * Dim + d] - mapped[i * Dim + d]);
-            pic[d] += w[a] * vi[i * Dim + d];
-            if constexpr (trapezoid)
-              move[d] += w[a] * (0.5 * (start[i * Dim + d] + vi[i * Dim + d]));
-            else
-              move[d] += w[a] * start[i * Dim + d];
-          }
-        }
-        double speed2 = 0;
+    auto particle = [&](std::size_t p, StepSums& acc) {
+      acc.elastic += vol[p] * elastic_energy_density(sigma.data() + 6 * p, wave_modulus_[p], shear[p]);
+      const auto* nodes = st.nodes(p);
+      const auto* w = st.weights(p);
+      std::array<double, Dim> dv{}, pic{}, move{};
+      for (int a = 0; a < support; ++a) {
+        const std::size_t i = nodes[a];
         for (int d = 0; d < Dim; ++d) {
-          const double step = dt_ * move[d];
-          x[p * Dim + d] += step;
-          u[p * Dim + d] += step;
-          v[p * Dim + d] = flip_ * (v[p * Dim + d] + dv[d]) + (1.0 - flip_) * pic[d];
-          speed2 += v[p * Dim + d] * v[p * Dim + d];
+          // FLIP increment from the mapped velocity.
+          dv[d] += w[a] * (vi[i * Dim + d] - mapped[i * Dim + d]);
+          pic[d] += w[a] * vi[i * Dim + d];
+          if constexpr (trapezoid)
+            move[d] += w[a] * (0.5 * (start[i * Dim + d] + vi[i * Dim + d]));
+          else
+            move[d] += w[a] * start[i * Dim + d];
         }
-        kinetic += 0.5 * vol[p] * inertia[p] * speed2;
-        // The stable step of the state left (stable_time_step()'s limit, the same expression).
-        const double c = inertia[p] > 0 ? std::sqrt(wave_modulus_[p] / inertia[p]) : 0.0;
-        fastest = std::max(fastest, c + std::sqrt(speed2));
       }
-      kinetic_part[chunk] = kinetic;
-      elastic_part[chunk] = elastic;
-    }
+      double speed2 = 0;
+      for (int d = 0; d < Dim; ++d) {
+        const double step = dt_ * move[d];
+        x[p * Dim + d] += step;
+        u[p * Dim + d] += step;
+        v[p * Dim + d] = flip_ * (v[p * Dim + d] + dv[d]) + (1.0 - flip_) * pic[d];
+        speed2 += v[p * Dim + d] * v[p * Dim + d];
+      }
+      acc.kinetic += 0.5 * vol[p] * inertia[p] * speed2;
+      // The stable step of the state left (stable_time_step()'s limit, the same expression).
+      const double c = inertia[p] > 0 ? std::sqrt(wave_modulus_[p] / inertia[p]) : 0.0;
+      acc.fastest = std::max(acc.fastest, c + std::sqrt(speed2));
+    };
+    sums = ordered_chunk_reduce(n, StepSums{}, particle, [](StepSums total, const StepSums& chunk) {
+      total.kinetic += chunk.kinetic;
+      total.elastic += chunk.elastic;
+      total.fastest = std::max(total.fastest, chunk.fastest);
+      return total;
+    });
   };
   for_support<Dim>(K, [&](auto support) {
     trapezoidal_ ? update(support, std::true_type{}) : update(support, std::false_type{});
   });
+  const double fastest = sums.fastest;
   step_limit_ = fastest > 0 ? h / fastest : std::numeric_limits<double>::infinity();
   step_limit_valid_ = true;
   // Each footing moves as its nodes moved the material under it this step.
@@ -1066,12 +1067,8 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   }
   // The kinetic energy with the inertia the step used (mass scaling included: that is what must
   // stay small against the work for a scaled run to be quasi-static).
-  kinetic_energy_ = 0;
-  elastic_energy_ = 0;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    kinetic_energy_ += kinetic_part[c];
-    elastic_energy_ += elastic_part[c];
-  }
+  kinetic_energy_ = sums.kinetic;
+  elastic_energy_ = sums.elastic;
   // The work of gravity, tractions and plate loads over the step, with the step's mean velocity
   // at each node the force acts on.
   const auto g = kernel_->gravity();

@@ -54,23 +54,32 @@ void parallel_chunks(std::size_t n, std::size_t chunk, F&& f) {
     if (error) std::rethrow_exception(error);
 }
 
-/// Σ f(i) over [0, n), reproducible bitwise whatever the thread count: fixed chunks of 2048
-/// indices are summed in order, then the chunk sums in order.
-template <class F>
-double reproducible_sum(std::size_t n, F&& f) {
+/// A reduction over [0, n) whose result is bitwise the same whatever the thread count: the
+/// range is cut into fixed chunks of 2048 indices; each chunk starts from `init` and takes
+/// body(i, acc) for its indices in order; the chunks' results are then folded in chunk order,
+/// total = combine(total, chunk) from total = init. For several sums (and maxima) in one pass.
+template <class Acc, class Body, class Combine>
+Acc ordered_chunk_reduce(std::size_t n, const Acc& init, Body&& body, Combine&& combine) {
   constexpr std::size_t kChunk = 2048;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<double> partial(chunks, 0.0);
+  std::vector<Acc> partial(chunks, init);
 #pragma omp parallel for schedule(static) if (chunks > 1)
   for (std::size_t c = 0; c < chunks; ++c) {
-    double s = 0;
+    Acc acc = init;
     const std::size_t end = std::min(n, (c + 1) * kChunk);
-    for (std::size_t i = c * kChunk; i < end; ++i) s += f(i);
-    partial[c] = s;
+    for (std::size_t i = c * kChunk; i < end; ++i) body(i, acc);
+    partial[c] = acc;
   }
-  double total = 0;
-  for (double s : partial) total += s;
+  Acc total = init;
+  for (const Acc& acc : partial) total = combine(total, acc);
   return total;
+}
+
+/// Σ f(i) over [0, n), reproducible bitwise whatever the thread count (ordered_chunk_reduce).
+template <class F>
+double reproducible_sum(std::size_t n, F&& f) {
+  return ordered_chunk_reduce(
+      n, 0.0, [&](std::size_t i, double& s) { s += f(i); }, [](double a, double b) { return a + b; });
 }
 
 /// max f(i) over [0, n) (exact in any order), or `empty` when n = 0.
