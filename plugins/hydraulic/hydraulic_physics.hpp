@@ -147,6 +147,7 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> coupling_, coupling_transposed_;
   // assemble_skeleton()'s scratch for the rigid plates: Q_g by row, rows already met, and the
   // CSR position of each column of the row being added to
+  std::vector<std::pair<int, std::vector<std::size_t>>> plates_;  ///< this step's plates: group number, nodes (find_plates())
   std::vector<double> plate_column_;
   std::vector<char> plate_touched_;
   std::vector<std::size_t> slot_of_;
@@ -265,6 +266,7 @@ class HydraulicPhysics final : public Physics {
   void assemble();
   /// Coupled: adds Δt Q M⁻¹ Qᵀ, the skeleton's exact response to the pressure increment.
   void assemble_skeleton();
+  void find_plates();
   std::vector<std::vector<std::size_t>> group_rows() const;
 };
 

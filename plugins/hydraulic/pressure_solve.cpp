@@ -11,7 +11,6 @@
 #include <cmath>
 #include <iterator>
 #include <map>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -30,10 +29,11 @@ void HydraulicPhysics::assemble() {
   // A rigid plate's nodes change as it moves (and as nodes gain or lose mass), and with them the
   // rows it couples as one body: when they leave the graph's plate rows, the graph is built anew
   // with the union of both (it only grows), so that every pair the plate term adds to is in it.
+  // The plates and their rows are found once a step, for the graph here and the plate term.
+  find_plates();
+  const std::vector<std::vector<std::size_t>> plate_rows = group_rows();
   bool plates_outgrown = false;
-  std::vector<std::vector<std::size_t>> plate_rows;
   if (coupled_ && (system_ || restore_system_)) {  // after a restart: against the checkpoint's rows
-    plate_rows = group_rows();
     for (std::size_t g = 0; g < plate_rows.size() && !plates_outgrown; ++g)
       plates_outgrown = g >= graph_groups_.size() || !std::includes(graph_groups_[g].begin(), graph_groups_[g].end(),
                                                                    plate_rows[g].begin(), plate_rows[g].end());
@@ -62,7 +62,7 @@ void HydraulicPhysics::assemble() {
       // stencils apart (Q M⁻¹ Qᵀ), and every node near a rigid plate with every other (the plate
       // moves as one body); Q itself one stencil apart.
       const int reach = support_width(st.kind()) - 1;
-      if (!restore_system_ && !plates_outgrown) graph_groups_ = group_rows();
+      if (!restore_system_ && !plates_outgrown) graph_groups_ = plate_rows;
       graph_.build_lattice(kernel_->grid(), 2 * reach, graph_groups_);
       graph_.build_scatter(st);
       compact_.build_lattice(kernel_->grid(), reach);
@@ -274,23 +274,17 @@ void HydraulicPhysics::assemble_skeleton() {
       }
     }
   }
-  if (group.empty()) return;
+  if (plates_.empty()) return;
   // The plates: Q_g,i = Σ_{j ∈ g} Q_ij,axis over the rows that touch them; A += Δt Q_g Q_gᵀ / M_g,
   // group by group in ascending order, each Q_g,i summed over j and then over row j's entries.
-  std::vector<int> groups;
-  for (std::size_t j = 0; j < nodes; ++j)
-    if (group[j] > 0) groups.push_back(int(group[j]));
-  std::sort(groups.begin(), groups.end());
-  groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
   plate_column_.assign(nodes, 0.0);
   plate_touched_.assign(nodes, 0);
   slot_of_.resize(nodes);
-  for (const int g : groups) {
+  for (const auto& [g, plate_nodes] : plates_) {
     const int d = (g - 1) % kDim;
     double plate_mobility = 0;
     std::vector<std::size_t> rows;
-    for (std::size_t j = 0; j < nodes; ++j) {
-      if (!(group[j] > 0) || int(group[j]) != g) continue;
+    for (const std::size_t j : plate_nodes) {
       plate_mobility = mobility[j * kDim + d];  // the same on every node of the plate
       for (std::size_t f = compact_.offsets[j]; f < compact_.offsets[j + 1]; ++f) {
         const auto k = std::size_t(compact_.columns[f]);
@@ -318,33 +312,46 @@ void HydraulicPhysics::assemble_skeleton() {
   }
 }
 
-/// For each rigid plate, the rows its nodes' columns of Q reach (read from the node field the
-/// mechanical physics writes), for the graph.
+/// This step's rigid plates (read from the node field the mechanical physics writes): each
+/// group's number and its nodes, both ascending.
+void HydraulicPhysics::find_plates() {
+  plates_.clear();
+  if (!coupled_ || !node_solid_group_.bound()) return;
+  const auto group = node_solid_group_.values();
+  std::map<int, std::vector<std::size_t>> by_group;
+  for (std::size_t j = 0; j < group.size(); ++j)
+    if (group[j] > 0) by_group[int(group[j])].push_back(j);
+  plates_.assign(by_group.begin(), by_group.end());
+}
+
+/// For each rigid plate (find_plates()), the rows its nodes' columns of Q can reach, ascending:
+/// the graph must couple all of them with each other.
 std::vector<std::vector<std::size_t>> HydraulicPhysics::group_rows() const {
   std::vector<std::vector<std::size_t>> out;
-  if (!coupled_ || !node_solid_group_.bound()) return out;
-  const auto group = node_solid_group_.values();
   const auto& grid = kernel_->grid();
   const int reach = support_width(kernel_->transfer().stencil().kind()) - 1;
   // A row i touches plate node j when some particle's stencil could hold both: within `reach`
   // lattice steps along each axis.
-  std::map<int, std::set<std::size_t>> rows;
-  for (std::size_t j = 0; j < group.size(); ++j) {
-    if (!(group[j] > 0)) continue;
-    const auto ijk = grid.node_lattice(j);
-    std::array<int, kDim> at{};
-    for (at[1] = ijk[1] - reach; at[1] <= ijk[1] + reach; ++at[1])
-      for (at[0] = ijk[0] - reach; at[0] <= ijk[0] + reach; ++at[0]) {
-        bool inside = true;
-        std::array<int, kDim> wrapped{};
-        for (int d = 0; d < kDim; ++d) {
-          wrapped[d] = grid.wrap(d, at[d]);
-          inside = inside && wrapped[d] >= -grid.ghost_layers && wrapped[d] <= grid.cells[d] + grid.ghost_layers;
+  for (const auto& [_, plate_nodes] : plates_) {
+    std::vector<std::size_t> rows;
+    for (const std::size_t j : plate_nodes) {
+      const auto ijk = grid.node_lattice(j);
+      std::array<int, kDim> at{};
+      for (at[1] = ijk[1] - reach; at[1] <= ijk[1] + reach; ++at[1])
+        for (at[0] = ijk[0] - reach; at[0] <= ijk[0] + reach; ++at[0]) {
+          bool inside = true;
+          std::array<int, kDim> wrapped{};
+          for (int d = 0; d < kDim; ++d) {
+            wrapped[d] = grid.wrap(d, at[d]);
+            inside = inside && wrapped[d] >= -grid.ghost_layers && wrapped[d] <= grid.cells[d] + grid.ghost_layers;
+          }
+          if (inside) rows.push_back(grid.node_index(wrapped));
         }
-        if (inside) rows[int(group[j])].insert(grid.node_index(wrapped));
-      }
+    }
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    out.push_back(std::move(rows));
   }
-  for (auto& [_, r] : rows) out.emplace_back(r.begin(), r.end());
   return out;
 }
 
