@@ -23,9 +23,9 @@ MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<Csr
   levels_.resize(operators.size());
   for (std::size_t l = 0; l < operators.size(); ++l) {
     Level& level = levels_[l];
-    level.A = std::move(operators[l]);
-    const std::size_t n = level.A.rows;
-    if (level.A.cols != n) throw std::invalid_argument("MultigridCycle: operator " + std::to_string(l) + " not square");
+    const CsrMatrix& given = operators[l];  // as handed in: A holds its entries reordered (below)
+    const std::size_t n = given.rows;
+    if (given.cols != n) throw std::invalid_argument("MultigridCycle: operator " + std::to_string(l) + " not square");
     if (l + 1 < operators.size()) {
       level.P = std::move(prolongators[l]);
       if (level.P.rows != n || level.P.cols != operators[l + 1].rows)
@@ -46,8 +46,11 @@ MultigridCycle::MultigridCycle(std::vector<CsrMatrix> operators, std::vector<Csr
     level.in_block_end.assign(n, 0);
     level.lower_end.assign(n, 0);
     auto& A = level.A;
-    level.source.resize(A.nonzeros());
-    const CsrMatrix given = A;  // as handed in; A's entries are reordered below
+    A.rows = A.cols = n;
+    A.offsets = given.offsets;
+    A.columns.resize(given.nonzeros());
+    A.values.resize(given.nonzeros());
+    level.source.resize(given.nonzeros());
     std::vector<std::size_t> outside;
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t block_begin = i / level.block_rows * level.block_rows;
