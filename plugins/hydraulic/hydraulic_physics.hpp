@@ -145,9 +145,9 @@ class HydraulicPhysics final : public Physics {
   // Coupled: Q, the mass balance's dependence on the skeleton's nodal velocity (Dim values per
   // entry of the graph), and its transpose; the pressure matrix holds Δt Q M⁻¹ Qᵀ
   std::vector<double> coupling_, coupling_transposed_;
+  std::vector<std::pair<int, std::vector<std::size_t>>> plates_;  ///< this step's rigid plates: group number, nodes (find_plates())
   // assemble_skeleton()'s scratch for the rigid plates: Q_g by row, rows already met, and the
   // CSR position of each column of the row being added to
-  std::vector<std::pair<int, std::vector<std::size_t>>> plates_;  ///< this step's plates: group number, nodes (find_plates())
   std::vector<double> plate_column_;
   std::vector<char> plate_touched_;
   std::vector<std::size_t> slot_of_;
