@@ -353,3 +353,33 @@ TEST_CASE("ParticleFieldWriter: reopen keeps the first frames in step order, dro
   REQUIRE_THAT(runtime_error_of([&] { ParticleFieldWriter::reopen(tmp.file("nowhere"), 2, 0); }),
                Contains("nowhere/fields.h5"));
 }
+
+TEST_CASE("ParticleFieldWriter: reopen drops a frame whose object header a kill left broken, the rest readable",
+          "[io]") {
+  require_python_with_h5py();
+  TempDir tmp;
+  const std::string out = tmp.file("out");
+  const std::vector<ExpectedFrame> frames = {cloud_2d(0.0, 0, 4), cloud_2d(0.5, 10, 5), cloud_2d(0.75, 20, 6)};
+  {
+    ParticleFieldWriter writer(out, 2);
+    for (const auto& f : frames) write_frame(writer, f);
+  }
+  // The newest frame's group header overwritten, as a SIGKILL while it is written can leave it:
+  // its link is there, the object it names cannot be read (nor its link deleted: HDF5 updates
+  // the object's header for that).
+  const std::string h5 = out + "/fields.h5";
+  const auto broken = frostmpm::test::run_command(
+      kPython + " -c \"import h5py; f = h5py.File('" + h5 +
+      "', 'r'); a = h5py.h5o.get_info(f['step_000020'].id).addr; f.close(); g = open('" + h5 +
+      "', 'r+b'); g.seek(a); g.write(b'\\xff' * 16); g.close()\"");
+  INFO(broken.output);
+  REQUIRE(broken.exit_code == 0);
+  {
+    ParticleFieldWriter writer = ParticleFieldWriter::reopen(out, 2, 2);
+    REQUIRE(writer.frames() == 2);
+    write_frame(writer, frames[2]);  // the broken frame's step, written again
+  }
+  const auto result = check_with_reader(tmp, out, frames);
+  INFO(result.output);
+  REQUIRE(result.exit_code == 0);
+}

@@ -275,14 +275,34 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
   // the rest.
   std::vector<std::string> torn;
   const auto stored = ParticleFieldReader::list_frames(file, &torn);
-  for (const auto& name : torn)
-    hdf5::check(H5Ldelete(file, name.c_str(), H5P_DEFAULT), "deleting the cut-short frame " + name);
   if (stored.size() < keep_frames)
     throw std::runtime_error("ParticleFieldWriter: " + impl->h5_path() + " holds " + std::to_string(stored.size()) +
                              " frames, fewer than the " + std::to_string(keep_frames) + " to keep");
-  for (std::size_t i = keep_frames; i < stored.size(); ++i)
-    hdf5::check(H5Ldelete(file, stored[i].group.c_str(), H5P_DEFAULT), "deleting " + stored[i].group);
-  for (std::size_t i = 0; i < keep_frames; ++i) impl->add_to_xdmf(read_layout(file, stored[i].group), stored[i].step);
+  if (torn.empty()) {
+    for (std::size_t i = keep_frames; i < stored.size(); ++i)
+      hdf5::check(H5Ldelete(file, stored[i].group.c_str(), H5P_DEFAULT), "deleting " + stored[i].group);
+  } else {
+    // HDF5 cannot delete a link whose object header was left half written (deleting updates
+    // the header), so the frames to keep are copied into a new file that replaces this one
+    // (rename: atomic; until then fields.h5 is as the kill left it).
+    const std::string partial = impl->h5_path() + ".partial";
+    {
+      const hdf5::Handle copy = hdf5::create_file(partial);
+      hdf5::write_attribute(copy.get(), "dim", dim);
+      for (std::size_t i = 0; i < keep_frames; ++i)
+        hdf5::check(H5Ocopy(file, stored[i].group.c_str(), copy.get(), stored[i].group.c_str(), H5P_DEFAULT,
+                            H5P_DEFAULT),
+                    "copying " + stored[i].group + " out of a file with the cut-short frame " + torn.front());
+      hdf5::check(H5Fflush(copy.get(), H5F_SCOPE_GLOBAL), "writing " + partial);
+    }
+    impl->file = hdf5::Handle();
+    std::error_code ec;
+    std::filesystem::rename(partial, impl->h5_path(), ec);
+    if (ec) throw std::runtime_error("ParticleFieldWriter: replacing " + impl->h5_path() + ": " + ec.message());
+    impl->file = hdf5::open_file(impl->h5_path(), /*writable=*/true);
+  }
+  for (std::size_t i = 0; i < keep_frames; ++i)
+    impl->add_to_xdmf(read_layout(impl->file.get(), stored[i].group), stored[i].step);
   impl->flush();
   impl->write_xdmf();
   return ParticleFieldWriter(std::move(impl));
