@@ -286,7 +286,7 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
     // the header), so the frames to keep are copied into a new file that replaces this one
     // (rename: atomic; until then fields.h5 is as the kill left it).
     const std::string partial = impl->h5_path() + ".partial";
-    {
+    try {
       const hdf5::Handle copy = hdf5::create_file(partial);
       hdf5::write_attribute(copy.get(), "dim", dim);
       for (std::size_t i = 0; i < keep_frames; ++i)
@@ -294,6 +294,10 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
                             H5P_DEFAULT),
                     "copying " + stored[i].group + " out of a file with the cut-short frame " + torn.front());
       hdf5::check(H5Fflush(copy.get(), H5F_SCOPE_GLOBAL), "writing " + partial);
+    } catch (...) {
+      std::error_code ignored;
+      std::filesystem::remove(partial, ignored);  // fields.h5 stays as it was
+      throw;
     }
     impl->file = hdf5::Handle();
     std::error_code ec;
