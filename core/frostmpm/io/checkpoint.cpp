@@ -1,19 +1,16 @@
 #include "frostmpm/io/checkpoint.hpp"
 
-#include <fcntl.h>
 #include <hdf5.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
 
 #include "frostmpm/config/input_error.hpp"
 #include "frostmpm/io/hdf5_support.hpp"
+#include "frostmpm/io/output_dir.hpp"
 
 namespace fs = std::filesystem;
 
@@ -23,16 +20,6 @@ namespace {
 
 constexpr const char* kFileName = "checkpoint.h5";
 constexpr int kFormat = 1;
-
-/// fsync of a file or folder, so the data are on disk before the rename that publishes them.
-void sync_to_disk(const std::string& path, int flags) {
-  const int fd = ::open(path.c_str(), flags);
-  if (fd < 0) throw std::runtime_error("opening " + path + " for fsync failed: " + std::strerror(errno));
-  const int status = ::fsync(fd);
-  const int error = errno;
-  ::close(fd);
-  if (status != 0) throw std::runtime_error("fsync of " + path + " failed: " + std::strerror(error));
-}
 
 /// A failure inside `fn` becomes one InputError line: `prefix` + the HDF5 or system message.
 template <class F>
@@ -86,7 +73,7 @@ void remove_checkpoint(const std::string& dir) {
 // ---- writer --------------------------------------------------------------------------------
 
 struct CheckpointWriter::Impl {
-  std::string dir, final_path, partial_path;
+  std::string final_path, partial_path;
   hdf5::Handle file;
   bool committed = false;
 
@@ -114,7 +101,6 @@ struct CheckpointWriter::Impl {
 };
 
 CheckpointWriter::CheckpointWriter(const std::string& dir) : impl_(std::make_unique<Impl>()) {
-  impl_->dir = dir;
   impl_->final_path = checkpoint_path(dir);
   impl_->partial_path = impl_->final_path + ".partial";
   try {
@@ -194,15 +180,8 @@ void CheckpointWriter::commit() {
     hdf5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_GLOBAL), "flushing");
     hdf5::reserve(impl_->file.get(), impl_->partial_path, 0, 0);
     impl_->file.close("closing");
-    sync_to_disk(impl_->partial_path, O_RDONLY);
-    fs::rename(impl_->partial_path, impl_->final_path);
+    publish_synced(impl_->partial_path, impl_->final_path);
     impl_->committed = true;
-    // The rename itself reaches the disk with the folder's metadata; not every file system
-    // can fsync a folder, and the checkpoint is complete either way.
-    try {
-      sync_to_disk(impl_->dir, O_RDONLY | O_DIRECTORY);
-    } catch (const std::runtime_error&) {
-    }
   });
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 namespace fs = std::filesystem;
@@ -73,6 +74,29 @@ void write_file_atomically(const std::string& path, std::string_view text, const
     std::error_code ignored;
     fs::remove(temp_path, ignored);  // no empty or cut-short .partial left behind
     throw OutputError(path, e.reason(), when);  // the file the user knows, not the .partial
+  }
+}
+
+namespace {
+/// fsync of a file or folder.
+void sync_to_disk(const std::string& path, int flags) {
+  const int fd = ::open(path.c_str(), flags);
+  if (fd < 0) throw std::runtime_error("opening " + path + " for fsync failed: " + std::strerror(errno));
+  const int status = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (status != 0) throw std::runtime_error("fsync of " + path + " failed: " + std::strerror(error));
+}
+}  // namespace
+
+void publish_synced(const std::string& partial_path, const std::string& final_path) {
+  sync_to_disk(partial_path, O_RDONLY);
+  fs::rename(partial_path, final_path);
+  // The rename itself reaches the disk with the folder's metadata; not every file system can
+  // fsync a folder, and the file is complete either way.
+  try {
+    sync_to_disk(fs::path(final_path).parent_path().string(), O_RDONLY | O_DIRECTORY);
+  } catch (const std::runtime_error&) {
   }
 }
 

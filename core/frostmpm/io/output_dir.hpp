@@ -55,6 +55,12 @@ class CheckedFile {
 /// removed and an earlier `path` stays as it was. `when` as for OutputError.
 void write_file_atomically(const std::string& path, std::string_view text, const std::string& when = "");
 
+/// Publishes a finished file written as `partial_path` under `final_path`: its data synced to
+/// disk, then the rename (atomic), then the folder synced where the file system allows it. A
+/// crash at any point leaves either the earlier `final_path` or the new one, whole.
+/// std::runtime_error if the sync or the rename fails (the .partial is then still there).
+void publish_synced(const std::string& partial_path, const std::string& final_path);
+
 class OutputDir {
  public:
   /// Creates the folder if needed; an InputError if it cannot be created or written.

@@ -283,26 +283,25 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
       hdf5::check(H5Ldelete(file, stored[i].group.c_str(), H5P_DEFAULT), "deleting " + stored[i].group);
   } else {
     // HDF5 cannot delete a link whose object header was left half written (deleting updates
-    // the header), so the frames to keep are copied into a new file that replaces this one
-    // (rename: atomic; until then fields.h5 is as the kill left it).
+    // the header), so the frames to keep are copied into a new file that replaces this one as
+    // a checkpoint is published (until then fields.h5 is as the kill left it).
     const std::string partial = impl->h5_path() + ".partial";
     try {
-      const hdf5::Handle copy = hdf5::create_file(partial);
-      hdf5::write_attribute(copy.get(), "dim", dim);
-      for (std::size_t i = 0; i < keep_frames; ++i)
-        hdf5::check(H5Ocopy(file, stored[i].group.c_str(), copy.get(), stored[i].group.c_str(), H5P_DEFAULT,
-                            H5P_DEFAULT),
-                    "copying " + stored[i].group + " out of a file with the cut-short frame " + torn.front());
-      hdf5::check(H5Fflush(copy.get(), H5F_SCOPE_GLOBAL), "writing " + partial);
+      {
+        const hdf5::Handle copy = hdf5::create_file(partial);
+        hdf5::write_attribute(copy.get(), "dim", dim);
+        for (std::size_t i = 0; i < keep_frames; ++i)
+          hdf5::check(H5Ocopy(file, stored[i].group.c_str(), copy.get(), stored[i].group.c_str(), H5P_DEFAULT,
+                              H5P_DEFAULT),
+                      "copying " + stored[i].group + " out of a file with the cut-short frame " + torn.front());
+      }
+      impl->file = hdf5::Handle();
+      publish_synced(partial, impl->h5_path());
     } catch (...) {
       std::error_code ignored;
       std::filesystem::remove(partial, ignored);  // fields.h5 stays as it was
       throw;
     }
-    impl->file = hdf5::Handle();
-    std::error_code ec;
-    std::filesystem::rename(partial, impl->h5_path(), ec);
-    if (ec) throw std::runtime_error("ParticleFieldWriter: replacing " + impl->h5_path() + ": " + ec.message());
     impl->file = hdf5::open_file(impl->h5_path(), /*writable=*/true);
   }
   for (std::size_t i = 0; i < keep_frames; ++i)
