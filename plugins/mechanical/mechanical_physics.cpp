@@ -1057,8 +1057,7 @@ void MechanicalPhysics<Dim>::map_to_particles() {
   for_support<Dim>(K, [&](auto support) {
     trapezoidal_ ? update(support, std::true_type{}) : update(support, std::false_type{});
   });
-  const double fastest = sums.fastest;
-  step_limit_ = fastest > 0 ? h / fastest : std::numeric_limits<double>::infinity();
+  step_limit_ = sums.fastest > 0 ? h / sums.fastest : std::numeric_limits<double>::infinity();
   step_limit_valid_ = true;
   // Each footing moves as its nodes moved the material under it this step.
   for (auto& f : footings_) {
