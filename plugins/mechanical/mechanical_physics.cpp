@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <type_traits>
 
@@ -669,13 +670,15 @@ void MechanicalPhysics<Dim>::update_stress() {
         const auto& m = materials_[r.material];
         parallel_chunks(r.size(), kChunk, [&](std::size_t offset, std::size_t k) {
           const std::size_t b = r.begin + offset;
-          std::vector<double> de(6 * k), rotated(6 * k);
+          // Written whole below before they are read: no zeroing (120k particles: 11 MB a step).
+          const auto de = std::make_unique_for_overwrite<double[]>(6 * k);
+          const auto rotated = std::make_unique_for_overwrite<double[]>(6 * k);
           for (std::size_t i = 0; i < k; ++i) {
             const std::size_t p = b + i;
-            const Kinematics step = kinematics(support, p, de.data() + 6 * i, rotated.data() + 6 * i);
+            const Kinematics step = kinematics(support, p, de.get() + 6 * i, rotated.get() + 6 * i);
             close_volume(p, step.J_ratio, step.grain_expansion);
           }
-          integrate_chunk(m, b, k, de.data(), rotated.data());
+          integrate_chunk(m, b, k, de.get(), rotated.get());
         });
       }
     });
@@ -964,7 +967,7 @@ void MechanicalPhysics<Dim>::correct() {
 /// The elastic energy per volume an isotropic material with P-wave modulus M and shear modulus
 /// G stores at σ′: p²/(2K) + s:s/(4G), K = M − 4G/3 (0 where the moduli are not known).
 template <int Dim>
-double MechanicalPhysics<Dim>::elastic_energy_density(const double* s, double M, double G) {
+[[gnu::always_inline]] inline double MechanicalPhysics<Dim>::elastic_energy_density(const double* s, double M, double G) {
   const double K = M - 4.0 * G / 3.0;
   if (!(K > 0 && G > 0)) return 0.0;
   const double mean = (s[0] + s[1] + s[2]) / 3.0;

@@ -155,3 +155,47 @@ TEST_CASE("parallel_chunks covers the range once in fixed chunks and rethrows th
   parallel_chunks(0, 512, [&](std::size_t, std::size_t) { ++calls; });
   REQUIRE(calls == 0);
 }
+
+TEST_CASE("coloured blocks rebuilt after particles moved are the blocks a fresh build makes", "[parallel]") {
+  UniformGrid<2> grid;
+  grid.spacing = {0.1, 0.1};
+  grid.cells = {80, 12};
+  grid.ghost_layers = ghost_layers(ShapeKind::Gimp);
+  std::vector<double> pos, half;
+  for (int i = 2; i < 70 * 2; ++i)  // room on the right for the moves below
+    for (int j = 4; j < 10 * 2; ++j) {
+      pos.insert(pos.end(), {(i + 0.5) * 0.05, (j + 0.5) * 0.05});
+      half.insert(half.end(), {0.025, 0.025});
+    }
+  StencilCache<2> stencil;
+  stencil.configure(ShapeKind::Gimp);
+  ColouredBlocks<2> kept;
+  auto same_as_fresh = [&] {
+    REQUIRE(stencil.update(grid, pos, half) == -1);
+    kept.build(grid, stencil, 3);
+    ColouredBlocks<2> fresh;
+    fresh.build(grid, stencil, 3);
+    REQUIRE(kept.blocks() == fresh.blocks());
+    for (int c = 0; c <= ColouredBlocks<2>::kGroups; ++c) REQUIRE(kept.first_block(c) == fresh.first_block(c));
+    for (std::uint32_t b = 0; b < fresh.blocks(); ++b) {
+      const auto a = kept.block(b), f = fresh.block(b);
+      REQUIRE(std::equal(a.begin(), a.end(), f.begin(), f.end()));
+    }
+  };
+  same_as_fresh();
+  const std::size_t p = 17 * 16 + 5;  // x = 0.875 m: lowest node 8 of the first 32-node block
+  SECTION("a particle that moved a cell along x inside its block") {
+    pos[2 * p] += 0.1;
+    same_as_fresh();
+  }
+  SECTION("particles that moved into the next block along x, then back") {
+    for (std::size_t q = 0; q < pos.size() / 2; ++q) pos[2 * q] += 0.3;  // 3 cells: some cross x = 3.1 m
+    same_as_fresh();
+    for (std::size_t q = 0; q < pos.size() / 2; ++q) pos[2 * q] -= 0.3;
+    same_as_fresh();
+  }
+  SECTION("one particle that moved into the next block row along y") {
+    pos[2 * p + 1] += 0.2;
+    same_as_fresh();
+  }
+}

@@ -904,7 +904,7 @@ void Simulation::run(const OutputDir& out, const RunOptions& options) {
   const double time_start = time_;
   auto last_print = wall_start, last_checkpoint = wall_start;
   // The step loop's work outside advance(), timed as stages too: run.json's stages then add up
-  // to the whole step loop but for metrics, frames and checkpoints.
+  // to the whole step loop but for metrics and frames (checkpoints are kernel.checkpoint).
   auto timed = [&](const char* name, auto&& fn) {
     const auto start = Clock::now();
     fn();

@@ -1,6 +1,7 @@
 #include "frostmpm/transfer/coloured_blocks.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -38,7 +39,23 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
   // and highest node; it goes to the serial block `block_count` (a periodic axis has more cells
   // than the support is wide, so an unwrapped stencil never spans that far).
   const std::size_t wrapped_block = block_count;
-  std::vector<std::uint32_t> block_of(n);
+  // A particle whose stencil changed mostly stays in its block (32 × 3 nodes): when none left
+  // its block, the order, blocks and colours below would come out as they are, and are kept.
+  std::array<int, Dim> nodes_along{};
+  for (int d = 0; d < Dim; ++d) nodes_along[d] = grid.nodes_along(d);
+  const bool same_layout = block_of_.size() == n && width == width_ && nodes_along == nodes_along_ && !order_.empty();
+  block_of_.resize(n);
+  width_ = width;
+  nodes_along_ = nodes_along;
+  std::atomic<bool> moved{!same_layout};
+  std::vector<std::uint32_t>& block_of = block_of_;
+  auto assign = [&](std::size_t p, std::size_t block) {
+    const auto b = static_cast<std::uint32_t>(block);
+    if (block_of[p] != b) {
+      block_of[p] = b;
+      moved.store(true, std::memory_order_relaxed);
+    }
+  };
   parallel_for(n, [&](std::size_t p) {
     const auto* nodes = stencil.nodes(p);
     std::uint32_t lowest = nodes[0], highest = nodes[0];
@@ -51,7 +68,7 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
       const auto high = grid.node_lattice(highest);
       for (int d = 0; d < Dim; ++d)
         if (std::abs(high[d] - low[d]) >= width) {
-          block_of[p] = static_cast<std::uint32_t>(wrapped_block);
+          assign(p, wrapped_block);
           return;
         }
     }
@@ -59,8 +76,12 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
     for (int d = Dim - 1; d >= 0; --d)
       index = index * static_cast<std::size_t>(blocks_along[d]) +
               static_cast<std::size_t>((low[d] + grid.ghost_layers) / size[d]);
-    block_of[p] = static_cast<std::uint32_t>(index);
+    assign(p, index);
   });
+  if (!moved.load()) {
+    version_ = stencil.version();
+    return;
+  }
   std::vector<std::uint32_t> count(block_count + 1, 0);
   for (std::size_t p = 0; p < n; ++p) ++count[block_of[p]];
   auto colour_of = [&](std::size_t block) {

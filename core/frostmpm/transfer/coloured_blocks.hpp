@@ -36,7 +36,8 @@ class ColouredBlocks {
   static constexpr int kGroups = kColours + 1;
 
   /// Groups the stencil's particles into coloured blocks. Call again whenever the stencil
-  /// topology changes (StencilCache::topology_changed()).
+  /// topology changes (StencilCache::topology_changed()); when no particle changed block, the
+  /// grouping (the same one) is kept without being redone.
   void build(const UniformGrid<Dim>& grid, const StencilCache<Dim>& stencil, int width);
 
   /// Runs f(p) for every particle: colour by colour, the blocks of a colour in parallel, the
@@ -68,6 +69,10 @@ class ColouredBlocks {
   std::vector<std::uint32_t> block_begin_;  ///< blocks sorted by colour; block b = order_[begin[b], begin[b+1])
   std::array<std::uint32_t, kGroups + 1> colour_begin_{};  ///< blocks of colour c: [begin[c], begin[c+1])
   std::uint64_t version_ = 0;
+  // What the last build grouped: each particle's block, for the grid and width it was made for.
+  std::vector<std::uint32_t> block_of_;
+  int width_ = 0;
+  std::array<int, Dim> nodes_along_{};
 };
 
 }  // namespace frostmpm
