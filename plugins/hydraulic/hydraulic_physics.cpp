@@ -294,12 +294,12 @@ void HydraulicPhysics::update_coefficients() {
     const double conductivity = std::max(transport_scaling_ * k_a_[p] * k_r_[p], 1e-300);
     drag_[p] = n_l_[p] * n_l_[p] * rho * reference_gravity_ / conductivity;
     const double inertia = mass_scaling_ * (n_l_[p] * rho);
-    xi_[p] = inertia > 0 ? inertia / (inertia + dt_ * drag_[p]) : 0.0;
+    xi_[p] = two_phase::liquid_response(inertia, drag_[p], dt_).xi;
     storage_[p] = n_l_[p] * m.compressibility;
-    // The liquid's own response n_l/(m_l + Δt C_d) (= ξ/ρ_l) and its Poisson coefficient
-    // η = n_l²/(m_l + Δt C_d), written so that Δt → 0 stays finite; a moving skeleton adds its
-    // own response in the matrix (assemble_skeleton).
-    mobility_[p] = inertia > 0 ? n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
+    // The liquid's own response n_l/(m_l + Δt C_d) (= ξ/ρ_l: the corrector of a rigid skeleton)
+    // and its Poisson coefficient η = n_l²/(m_l + Δt C_d), written so that Δt → 0 stays finite;
+    // a moving skeleton adds its own response in the matrix (assemble_skeleton).
+    mobility_[p] = two_phase::corrector_mobility(INFINITY, inertia, n_l_[p], drag_[p], dt_).liquid;
     eta_[p] = inertia > 0 ? n_l_[p] * n_l_[p] / (inertia + dt_ * drag_[p]) : 0.0;
   });
 }
@@ -494,7 +494,7 @@ void HydraulicPhysics::drag() {
     const auto grad = nodal_gradient_at(st, q, *p_);
     const double weight = n_l_[q] * materials_[material_[q]].water_density, inertia = mass_scaling_ * weight,
                  denominator = inertia + dt_ * drag_[q];
-    k[q] = drag_[q] * xi_[q];
+    k[q] = two_phase::liquid_response(inertia, drag_[q], dt_).drag_stiffness;
     share[q] = n_l_[q] * xi_[q];
     for (int d = 0; d < kDim; ++d) {
       const double f = weight * gravity_[d] - n_l_[q] * grad[d];  // f_l

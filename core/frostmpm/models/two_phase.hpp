@@ -1,8 +1,12 @@
 #pragma once
 // The two-phase momentum balance of the fractional step (paper Sec. 4.1, Eqs. 43–49), per unit
-// volume at a material point, in one place: the hydraulic physics (the liquid) and the
-// mechanical physics (the skeleton) both take their coefficients from here, so neither
-// repeats the other's formulas. Inputs are inertias per unit volume — the skeleton's
+// volume at a material point, in one place. The hydraulic physics takes the liquid's
+// coefficients from here (liquid_response: ξ and the drag stiffness k it hands the mechanical
+// physics as particle fields; corrector_mobility of a rigid skeleton: the liquid's own response
+// n_l/(m_l + Δt C_d)); the mechanical physics only reads those fields, so neither repeats the
+// other's formulas. With a moving skeleton the skeleton's response to Δp enters the pressure
+// matrix at the nodes (HydraulicPhysics::assemble_skeleton) rather than through the per-point
+// λ_s below, whose closed forms and limits the unit tests state. Inputs are inertias per unit volume — the skeleton's
 // m_s = n_s ρ_s + n_c ρ_c and the liquid's m_l = n_l ρ_l, both times any mass scaling — the
 // drag coefficient C_d = n_l² ρ_l g / (K k_r) (Eq. 9) and the step Δt; D = Δt C_d.
 //
@@ -35,9 +39,10 @@ struct LiquidResponse {
 };
 
 inline LiquidResponse liquid_response(double m_l, double drag, double dt) {
-  const double denominator = m_l + dt * drag;
-  if (denominator <= 0) return {1.0, 0.0};  // no liquid and no drag: nothing couples
-  return {m_l / denominator, drag * m_l / denominator};
+  // No liquid: no momentum of its own (ξ = 0, it moves with the skeleton) and no drag.
+  if (!(m_l > 0)) return {0.0, 0.0};
+  const double xi = m_l / (m_l + dt * drag);
+  return {xi, drag * xi};
 }
 
 /// Velocity change per unit pressure-increment gradient and per unit Δt, of each phase.
