@@ -494,7 +494,7 @@ void HydraulicPhysics::drag() {
     const auto grad = nodal_gradient_at(st, q, *p_);
     const double weight = n_l_[q] * materials_[material_[q]].water_density, inertia = mass_scaling_ * weight,
                  denominator = inertia + dt_ * drag_[q];
-    k[q] = two_phase::liquid_response(inertia, drag_[q], dt_).drag_stiffness;
+    k[q] = drag_[q] * xi_[q];  // two_phase::liquid_response's k = C_d ξ, with its ξ (update_coefficients)
     share[q] = n_l_[q] * xi_[q];
     for (int d = 0; d < kDim; ++d) {
       const double f = weight * gravity_[d] - n_l_[q] * grad[d];  // f_l

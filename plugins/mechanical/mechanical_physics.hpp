@@ -172,7 +172,7 @@ class MechanicalPhysics final : public Physics {
   bool primed_ = false;  ///< previous_T_ holds the temperature of the last stress update
   double kinetic_energy_ = 0, elastic_energy_ = 0, external_work_ = 0, kinetic_to_work_max_ = 0;
   double removed_mass_ = 0;  ///< mass of the particles removed after leaving the grid
-  static double elastic_energy_density(const double* stress, double p_wave_modulus, double shear_modulus);
+  static inline double elastic_energy_density(const double* stress, double p_wave_modulus, double shear_modulus);
   std::vector<double> saved_scalars_;
 
   void read_boundaries(Kernel<Dim>& kernel);

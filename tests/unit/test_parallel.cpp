@@ -183,19 +183,30 @@ TEST_CASE("coloured blocks rebuilt after particles moved are the blocks a fresh 
     }
   };
   same_as_fresh();
-  const std::size_t p = 17 * 16 + 5;  // x = 0.875 m: lowest node 8 of the first 32-node block
+  const std::size_t p = 17 * 16 + 5;  // x = 0.975 m: lowest node 9, inside the first 32-node block
   SECTION("a particle that moved a cell along x inside its block") {
     pos[2 * p] += 0.1;
     same_as_fresh();
   }
   SECTION("particles that moved into the next block along x, then back") {
-    for (std::size_t q = 0; q < pos.size() / 2; ++q) pos[2 * q] += 0.3;  // 3 cells: some cross x = 3.1 m
+    for (std::size_t q = 0; q < pos.size() / 2; ++q) pos[2 * q] += 0.3;  // 3 cells: some enter the next block
     same_as_fresh();
     for (std::size_t q = 0; q < pos.size() / 2; ++q) pos[2 * q] -= 0.3;
     same_as_fresh();
   }
   SECTION("one particle that moved into the next block row along y") {
     pos[2 * p + 1] += 0.2;
+    same_as_fresh();
+  }
+  SECTION("two particles of different blocks that swapped places") {
+    const std::size_t q = pos.size() / 2 - 1;  // the last one: x = 6.975 m, another block
+    std::swap(pos[2 * p], pos[2 * q]);
+    std::swap(pos[2 * p + 1], pos[2 * q + 1]);
+    same_as_fresh();
+  }
+  SECTION("the last particles removed (the rest where they were)") {
+    pos.resize(pos.size() - 2 * 40);
+    half.resize(half.size() - 2 * 40);
     same_as_fresh();
   }
 }

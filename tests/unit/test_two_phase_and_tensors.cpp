@@ -66,6 +66,15 @@ TEST_CASE("two-phase corrector: the corrected ξ_s, ξ_l and their drained and u
       CHECK((1 - n_l * r.xi) / (m_s + dt * r.drag_stiffness) == Approx(m.solid).epsilon(1e-12));
     }
   }
+  SECTION("a dry point (no liquid, so no drag): ξ = 0 and k = 0, the corrector's liquid mobility 0") {
+    const auto r = two_phase::liquid_response(0.0, 0.0, dt);
+    CHECK(r.xi == 0.0);
+    CHECK(r.drag_stiffness == 0.0);
+    CHECK(two_phase::corrector_mobility(INFINITY, 0.0, 0.0, 0.0, dt).liquid == 0.0);
+    const auto wet = two_phase::liquid_response(m_l, 0.0, dt);  // no drag: the liquid keeps its own
+    CHECK(wet.xi == 1.0);
+    CHECK(wet.drag_stiffness == 0.0);
+  }
   SECTION("a rigid skeleton (m_s → ∞): the liquid alone, ξ = m_l/(m_l + Δt C_d)") {
     const double drag = 5e5;
     const auto m = two_phase::corrector_mobility(INFINITY, m_l, n_l, drag, dt);

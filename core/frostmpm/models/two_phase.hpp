@@ -6,9 +6,10 @@
 // n_l/(m_l + Δt C_d)); the mechanical physics only reads those fields, so neither repeats the
 // other's formulas. With a moving skeleton the skeleton's response to Δp enters the pressure
 // matrix at the nodes (HydraulicPhysics::assemble_skeleton) rather than through the per-point
-// λ_s below, whose closed forms and limits the unit tests state. Inputs are inertias per unit volume — the skeleton's
-// m_s = n_s ρ_s + n_c ρ_c and the liquid's m_l = n_l ρ_l, both times any mass scaling — the
-// drag coefficient C_d = n_l² ρ_l g / (K k_r) (Eq. 9) and the step Δt; D = Δt C_d.
+// λ_s below, whose closed forms and limits the unit tests state. Inputs are inertias per unit
+// volume — the skeleton's m_s = n_s ρ_s + n_c ρ_c and the liquid's m_l = n_l ρ_l, both times any
+// mass scaling — the drag coefficient C_d = n_l² ρ_l g / (K k_r) (Eq. 9) and the step Δt;
+// D = Δt C_d.
 //
 // Predictor (Eq. 43). With the drag implicit, the liquid's own predictor is
 //   v_l* = ξ ṽ_l + (1 − ξ) v_s*,  ξ = m_l / (m_l + D),  ṽ_l = v_l + Δt f_l / m_l,
@@ -34,7 +35,7 @@ namespace frostmpm::two_phase {
 
 /// The liquid's implicit response to the drag in the predictor.
 struct LiquidResponse {
-  double xi = 1;              ///< ξ = m_l / (m_l + Δt C_d): the liquid's own share of its momentum
+  double xi = 0;              ///< ξ = m_l / (m_l + Δt C_d): the liquid's own share of its momentum
   double drag_stiffness = 0;  ///< k = C_d ξ [kg/m³/s]: the drag on the skeleton per unit velocity difference
 };
 

@@ -53,7 +53,8 @@ void ColouredBlocks<Dim>::build(const UniformGrid<Dim>& grid, const StencilCache
     const auto b = static_cast<std::uint32_t>(block);
     if (block_of[p] != b) {
       block_of[p] = b;
-      moved.store(true, std::memory_order_relaxed);
+      // Stored once, not by every moved particle: the threads would take turns at its line.
+      if (!moved.load(std::memory_order_relaxed)) moved.store(true, std::memory_order_relaxed);
     }
   };
   parallel_for(n, [&](std::size_t p) {
