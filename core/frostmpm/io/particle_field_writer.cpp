@@ -135,6 +135,13 @@ void check_dim(int dim) {
     throw std::invalid_argument("ParticleFieldWriter: dim must be 2 or 3, got " + std::to_string(dim));
 }
 
+/// A new, empty fields file: what a run starts with and what a restart copies kept frames into.
+hdf5::Handle create_fields_file(const std::string& path, int dim) {
+  hdf5::Handle file = hdf5::create_file(path);
+  hdf5::write_attribute(file.get(), "dim", dim);
+  return file;
+}
+
 }  // namespace
 
 // ---- writer --------------------------------------------------------------------------------
@@ -250,8 +257,7 @@ ParticleFieldWriter::ParticleFieldWriter(const std::string& dir, int dim) {
   // Readers (ParaView, scripts/read_fields.py) may open the file while the run is going on, so
   // it is created without HDF5 file locking.
   impl_->guarded("", [&] {
-    impl_->file = hdf5::create_file(impl_->h5_path());
-    hdf5::write_attribute(impl_->file.get(), "dim", dim);
+    impl_->file = create_fields_file(impl_->h5_path(), dim);
     impl_->flush();
   });
   // Replace any fields.xdmf of an earlier run at once: it would point into the truncated file.
@@ -288,8 +294,7 @@ ParticleFieldWriter ParticleFieldWriter::reopen(const std::string& dir, int dim,
     const std::string partial = impl->h5_path() + ".partial";
     try {
       {
-        const hdf5::Handle copy = hdf5::create_file(partial);
-        hdf5::write_attribute(copy.get(), "dim", dim);
+        const hdf5::Handle copy = create_fields_file(partial, dim);
         for (std::size_t i = 0; i < keep_frames; ++i)
           hdf5::check(H5Ocopy(file, stored[i].group.c_str(), copy.get(), stored[i].group.c_str(), H5P_DEFAULT,
                               H5P_DEFAULT),
