@@ -14,6 +14,7 @@
     /usr/bin/python3 scripts/plot_paper.py planar_slump OUT [OUT ...] [--png FILE] [--frame N]
     /usr/bin/python3 scripts/plot_paper.py planar_onset OUT_h1 OUT_h2 [OUT_h3 ...] [--png FILE]
     /usr/bin/python3 scripts/plot_paper.py footing_rates OUT_2 OUT_1 OUT_0.5 OUT_0.25 [--png FILE]
+    /usr/bin/python3 scripts/plot_paper.py footing_melt OUT_unthawed OUT_thawing [--frame N]
 
 inclusion: global T_min(t) and liquid water volume V_l(t) of the frozen-inclusion cases (Fig. 10,
 left), with the 13 INTERFROST codes' thaw-time ranges shaded (Grenier et al. 2018).
@@ -48,6 +49,9 @@ cell size, with the first-order extrapolation of the two finest and the infinite
 depth; the numbers are printed as a table. footing_rates: the
 strip footing pushed at different speeds (Sec. 5.3.2, Fig. 28): for each run the plastic deviatoric
 strain at d/B = 0.5, 1 and 1.5 with the 0 and −1 °C lines, and the footing pressures against d/B.
+footing_melt: no figure; for one frame (the last unless --frame) of an unthawed and a thawing
+footing run, the frozen ground under the footing against the sealed closed form (the volume its
+meltwater lacks, closed by its skeleton) and the thawed layer's suction against Darcy's estimate.
 Each OUT is a run folder (metrics.csv, fields.h5).
 Needs matplotlib, numpy and h5py (Debian's /usr/bin/python3). Every figure of one run:
 scripts/plot.py.
@@ -409,6 +413,51 @@ def footing(folders, png):
     frostplot.save(fig, png)
 
 
+def footing_melt(folders, frame):
+    """What the thawing ground's melting does under and beside the footing (Sec. 5.3.2): for
+    one frame of an unthawed and a thawing run of configs/paper/strip_footing.yaml (fields.h5
+    with porosity, liquid_saturation, temperature, pore_pressure, stress and displacement), the
+    frozen material points under the footing against their undrained closed form, and the
+    thawed layer's suction against Darcy's estimate. Printed, no figure."""
+    zeta, phi0 = 1 - 917.0 / 1000.0, 0.4
+    k = 1.0e-10 * 2.16e7  # k0 times the scene's transport scaling [m/s]
+    unthawed, thawing = (frostplot.read_fields.read_frames(f) for f in folders[:2])
+    a, b = unthawed[frame], thawing[frame]
+    if abs(a["time"] - b["time"]) > 1e-9 or len(a["coordinates"]) != len(b["coordinates"]):
+        sys.exit("footing_melt: the two runs' frames differ in time or particle count")
+    fa, fb = a["fields"], b["fields"]
+    start = b["coordinates"][:, :2] - np.asarray(fb["displacement"])[:, :2]
+    S_a, S_b = np.asarray(fa["liquid_saturation"]), np.asarray(fb["liquid_saturation"])
+    volume_ratio = lambda f: (1 - phi0) / (1 - np.asarray(f["porosity"]))  # grains keep their volume
+    mean_stress = lambda f: np.asarray(f["stress"])[:, :3].mean(axis=1)
+    print(f"t = {b['time']:.3f} s")
+    under = (start[:, 0] < 0.6) & (start[:, 1] > 4.8) & (S_b < 0.2)
+    dS = S_b[under] - S_a[under]
+    measured = np.log(volume_ratio(fb)[under] / volume_ratio(fa)[under])
+    phi = 1 - (1 - phi0) / volume_ratio(fb)[under]
+    sealed = -zeta * phi * dS / (1 - zeta * phi * (1 - S_b[under]))
+    print(f"frozen ground under the footing (x0 < 0.6 m, y0 > 4.8 m, S_l < 0.2), {under.sum()} points, medians:")
+    print(f"  temperature {np.median(np.asarray(fb['temperature'])[under]):.2f} degC (unthawed run -5), "
+          f"S_l {np.median(S_a[under]):.4f} -> {np.median(S_b[under]):.4f}")
+    print(f"  ln(J_thawing / J_unthawed) {np.median(measured):.5f}; sealed closed form "
+          f"-zeta phi dS_l / (1 - zeta n_c) {np.median(sealed):.5f} ({np.median(measured) / np.median(sealed):.0%})")
+    print(f"  mean effective stress {np.median(mean_stress(fb)[under] - mean_stress(fa)[under]) / 1e3:+.0f} kPa, "
+          f"pore pressure {np.median(np.asarray(fb['pore_pressure'])[under] - np.asarray(fa['pore_pressure'])[under]) / 1e3:+.0f} kPa "
+          "(thawing minus unthawed)")
+    m = metrics(folders[1])
+    t, X = m["time_s"], m["thaw_depth_x3"]
+    # X dX/dt = d(X²/2)/dt over ±0.05 s: the front steps from cell to cell
+    before, after = (int(np.argmin(abs(t - (b["time"] + d)))) for d in (-0.05, 0.05))
+    i = int(np.argmin(abs(t - b["time"])))
+    x_rate = (X[after] ** 2 - X[before] ** 2) / (2 * (t[after] - t[before]))
+    front = -1000 * 9.81 / k * zeta * phi0 * (1 - 0.0678) * x_rate
+    thawed = (start[:, 0] > 0.6) & (start[:, 0] < 3) & (start[:, 1] > 4.5) & (S_b > 0.95)
+    print(f"thawed layer beside the footing (0.6 < x0 < 3 m, y0 > 4.5 m, S_l > 0.95), {thawed.sum()} points: "
+          f"pore pressure median {np.median(np.asarray(fb['pore_pressure'])[thawed]) / 1e3:.0f} kPa")
+    print(f"  Darcy, the meltwater drawn down to the front at x = 3 m: X = {X[i]:.2f} m, X dX/dt = {x_rate:.2f} m2/s, "
+          f"p_front = -(rho_l g / k) zeta phi dS_l X dX/dt = {front / 1e3:.0f} kPa (half that mid-layer)")
+
+
 # ---- thaw slump (Sec. 5.3.1) ------------------------------------------------------------------
 
 SLUMP_SURFACE = [(0, 0.455), (0.35, 0.455), (1.1361128709, 0.105), (1.4, 0.105)]  # thaw_slump.yaml
@@ -611,7 +660,7 @@ def main():
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("figure", choices=["inclusion", "talik", "contours", "thaw", "mn", "rock", "stabilization",
                                                       "footing_thermal", "footing", "slump", "planar_slump",
-                                                      "planar_onset", "footing_rates"])
+                                                      "planar_onset", "footing_rates", "footing_melt"])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--png", help="output file (default: FIGURE.png in the current folder)")
     parser.add_argument("--frame", type=int, default=-1, help="frame for contours (default: the last)")
@@ -641,6 +690,9 @@ def main():
         planar_onset(args.folders, png)
     elif args.figure == "footing_rates":
         footing_rates(args.folders, png)
+    elif args.figure == "footing_melt":
+        footing_melt(args.folders, args.frame)
+        return
     else:
         contours(args.folders[0], png, args.frame)
     print(f"wrote {png}")

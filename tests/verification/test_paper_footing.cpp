@@ -10,12 +10,16 @@
 //     weakest: no ice cohesion where the mechanism runs, and no melting under the footing;
 //   - with the melting source of the pore-water balance switched off, thawing ground is weaker
 //     than frozen ground, in the paper's order;
-//   - with it on (the paper's Eq. 7), the meltwater's volume deficit draws the pore pressure of
-//     the thawing zone to −0.1 to −0.6 MPa, which raises the effective stress and the frictional
-//     strength (φ′ = 30°) above that of the undrained frozen ground (to d/B = 1 in the full
-//     run). docs/verification.md compares with the paper's code (both read the mixture's
-//     force and leave the ice's strength unsoftened; its tension cut-off, one falling value
-//     per material, was tried and raises the thawing ground further).
+//   - with it on (the paper's Eq. 7), the meltwater lacks ζ φ ΔS_l of the ice's volume: the
+//     frozen ground warming under the footing closes it by compressing its skeleton (200 kPa more
+//     effective stress at t = 0.1–0.2 s; at 0.1 s its volume change is 96 % of the sealed closed
+//     form that configs/verification/undrained_warming.yaml verifies), and the thawed layer beside
+//     it draws it in through itself under −0.1 to −0.2 MPa (Darcy's estimate −0.4 MPa at the
+//     front); the effective stress and the frictional strength (φ′ = 30°) rise above those of the
+//     undrained frozen ground (to d/B = 1 in the full run). docs/verification.md compares with
+//     the paper's code (both read the mixture's force and leave the ice's strength unsoftened;
+//     its tension cut-off, its k_r floor and its drained free surface were tried, none gives its
+//     order).
 #include <catch2/catch.hpp>
 
 #include <string>

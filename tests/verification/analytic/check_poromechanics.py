@@ -170,6 +170,33 @@ for R, psw, psc in zip([0.25, 0.5, 0.75, 1.0, 1.5, 2.0], sw_print, sc_print):
     check_close("Thaw", f"front condition R={R}", (P0 + gam * X - uf(X, t)) - cv / Xdot * ux, 0.0, 1e-7)
 
 # ------------------------------------------------------------------------------------------------
+# 3b. Sealed melting (SealedMelting): scipy's adaptive integrator on the same ODE (the header's
+#     RK4 must give its pressure, test_pressure_sources.cpp), and its first-order estimate.
+# ------------------------------------------------------------------------------------------------
+from scipy.integrate import solve_ivp
+
+zeta, phi0, c_l = 1 - 917.0 / 1000.0, 0.4, 1e-9
+M_sm = 1e8 * 0.7 / (1.3 * 0.4)
+sfcc = lambda T: (1 + (917.0 * 3.34e5 / 1e5 * -np.log((T + 273.15) / 273.15)) ** (1 / 0.6)) ** -0.4
+S0, S1 = sfcc(-5.0), sfcc(-1.0)
+
+
+def sealed_rate(S, y):
+    phi = 1 - (1 - phi0) * np.exp(-y[0])
+    return [-zeta * phi / (1 - zeta * phi * (1 - S) + phi * S * M_sm * c_l)]
+
+
+sm = solve_ivp(sealed_rate, [S0, S1], [0.0], rtol=1e-12, atol=1e-15)
+check("Sealed", "S_l(-5 C), Eq. 25 with lambda 0.4, p0 1e5", S0, "0.0678159")
+check("Sealed", "S_l(-1 C)", S1, "0.1979718")
+check("Sealed", "p = sigma'_yy = M ln J [Pa] (configs/verification/undrained_warming.yaml)", M_sm * sm.y[0, -1],
+      "-592557.4")
+check("Sealed", "settlement of 1 m [m]", 1 - np.exp(sm.y[0, -1]), "0.0043922")
+Sm = 0.5 * (S0 + S1)
+linear = -M_sm * zeta * phi0 * (S1 - S0) / (1 - zeta * phi0 * (1 - Sm) + phi0 * Sm * M_sm * c_l)
+check_close("Sealed", "first-order estimate within 0.5 %", linear / (M_sm * sm.y[0, -1]), 1.0, 5e-3)
+
+# ------------------------------------------------------------------------------------------------
 # 4. Elastic column under suddenly applied gravity
 # ------------------------------------------------------------------------------------------------
 E, nu, rho, H, g = 1e6, 0.3, 2000.0, 1.0, 9.81

@@ -11,6 +11,7 @@
 //   MandelSolution, mandel_*                      Mandel (1953) plane-strain squeeze
 //                                                 (Cheng & Detournay 1988; Abousleiman et al. 1996)
 //   ThawConsolidation, thaw_degree_*              Morgenstern & Nixon (1971) thaw consolidation
+//   SealedMelting                                 undrained melting: suction = skeleton compression
 //   ElasticColumn                                 confined column under suddenly applied gravity
 //   VibratingBar                                  first-mode (or n-th mode) axial vibration, fixed-free
 //   jaumann_*, rigid_rotation_exact               Jaumann-rate update of a rigidly rotated stress
@@ -451,6 +452,56 @@ class ThawConsolidation {
   }
   ThawConsolidationParams p_;
   double R_ = 0, A_ = 0, B_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// 3b. Frozen ground that warms while sealed (no flow), laterally confined, top traction-free,
+//     elastic skeleton with constrained modulus M, weightless, quasi-static. Pore ice melts from
+//     liquid saturation S0 to S1; the meltwater takes ζ φ dS_l less volume than the ice it came
+//     from (ζ = 1 − ρ_c/ρ_l). With no water able to flow in, the mass balance of the paper's
+//     Eq. 7 leaves the skeleton to close that volume and the water to expand:
+//       (1 − ζ n_c) d(ln J) + ζ φ dS_l + n_l c_l dp = 0,   n_c = φ (1 − S_l), n_l = φ S_l,
+//     with J = V/V0 and φ = 1 − (1 − φ0)/J (the grains keep their volume). The column's total
+//     stress is zero (free top), so σ′_yy = p (σ = σ′ − p I), and σ′_yy = M ln J (rate form).
+//     Hence dp = M d(ln J) and
+//       d(ln J)/dS_l = −ζ φ / (1 − ζ φ (1 − S_l) + φ S_l M c_l),
+//     integrated here by classical Runge–Kutta in S_l (the right side depends on J through φ).
+//     To first order: p ≈ −M ζ φ ΔS_l / (1 − ζ φ (1 − S̄) + φ S̄ M c_l): melting under undrained
+//     conditions puts the water under suction and the skeleton under the same compression.
+// ---------------------------------------------------------------------------------------------
+
+struct SealedMelting {
+  double phi0;  ///< porosity at the start
+  double zeta;  ///< 1 − ρ_c/ρ_l
+  double M;     ///< constrained modulus of the skeleton [Pa]
+  double c_l;   ///< compressibility of the water 1/K_l [1/Pa]
+
+  /// ln(V/V0) after the pore ice has melted from S0 to S1 (steps of RK4 in S_l).
+  double log_volume_ratio(double S0, double S1, int steps = 4000) const {
+    poro_detail::require(phi0 > 0.0 && phi0 < 1.0 && zeta >= 0.0 && zeta < 1.0 && M > 0.0 && c_l >= 0.0,
+                         "SealedMelting: needs 0 < phi0 < 1, 0 <= zeta < 1, M > 0, c_l >= 0");
+    poro_detail::require_domain(S0 >= 0.0 && S1 <= 1.0 && steps > 0, "SealedMelting: needs 0 <= S <= 1");
+    auto rate = [&](double S, double lnJ) {
+      const double phi = 1.0 - (1.0 - phi0) * std::exp(-lnJ);
+      return -zeta * phi / (1.0 - zeta * phi * (1.0 - S) + phi * S * M * c_l);
+    };
+    const double dS = (S1 - S0) / steps;
+    double lnJ = 0.0;
+    for (int i = 0; i < steps; ++i) {
+      const double S = S0 + i * dS;
+      const double k1 = rate(S, lnJ), k2 = rate(S + dS / 2, lnJ + dS * k1 / 2);
+      const double k3 = rate(S + dS / 2, lnJ + dS * k2 / 2), k4 = rate(S + dS, lnJ + dS * k3);
+      lnJ += dS * (k1 + 2 * k2 + 2 * k3 + k4) / 6;
+    }
+    return lnJ;
+  }
+
+  /// The pore pressure, equal to the skeleton's vertical effective stress σ′_yy [Pa] (negative:
+  /// suction and compression).
+  double pore_pressure(double S0, double S1) const { return M * log_volume_ratio(S0, S1); }
+
+  /// Settlement of a column of height H [m].
+  double settlement(double H, double S0, double S1) const { return H * (1.0 - std::exp(log_volume_ratio(S0, S1))); }
 };
 
 // ---------------------------------------------------------------------------------------------
