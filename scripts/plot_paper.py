@@ -419,14 +419,19 @@ def footing_melt(folders, frame):
     with porosity, liquid_saturation, temperature, pore_pressure, stress and displacement), the
     frozen material points under the footing against their undrained closed form, and the
     thawed layer's suction against Darcy's estimate. Printed, no figure."""
+    if len(folders) != 2:
+        sys.exit("footing_melt: give two run folders, the unthawed run and the thawing run")
     zeta, phi0 = 1 - 917.0 / 1000.0, 0.4
     k = 1.0e-10 * 2.16e7  # k0 times the scene's transport scaling [m/s]
-    unthawed, thawing = (frostplot.read_fields.read_frames(f) for f in folders[:2])
+    unthawed, thawing = (frostplot.read_fields.read_frames(f) for f in folders)
     a, b = unthawed[frame], thawing[frame]
-    if abs(a["time"] - b["time"]) > 1e-9 or len(a["coordinates"]) != len(b["coordinates"]):
-        sys.exit("footing_melt: the two runs' frames differ in time or particle count")
     fa, fb = a["fields"], b["fields"]
     start = b["coordinates"][:, :2] - np.asarray(fb["displacement"])[:, :2]
+    same = len(a["coordinates"]) == len(b["coordinates"]) and abs(a["time"] - b["time"]) < 1e-9
+    if not same or not np.allclose(start, a["coordinates"][:, :2] - np.asarray(fa["displacement"])[:, :2], atol=1e-9):
+        sys.exit("footing_melt: the two frames differ in time or in their material points")
+    if b["time"] <= 0:
+        sys.exit("footing_melt: pick a frame after the start (--frame 1 or later)")
     S_a, S_b = np.asarray(fa["liquid_saturation"]), np.asarray(fb["liquid_saturation"])
     volume_ratio = lambda f: (1 - phi0) / (1 - np.asarray(f["porosity"]))  # grains keep their volume
     mean_stress = lambda f: np.asarray(f["stress"])[:, :3].mean(axis=1)
@@ -439,23 +444,27 @@ def footing_melt(folders, frame):
     print(f"frozen ground under the footing (x0 < 0.6 m, y0 > 4.8 m, S_l < 0.2), {under.sum()} points, medians:")
     print(f"  temperature {np.median(np.asarray(fb['temperature'])[under]):.2f} degC (unthawed run -5), "
           f"S_l {np.median(S_a[under]):.4f} -> {np.median(S_b[under]):.4f}")
-    print(f"  ln(J_thawing / J_unthawed) {np.median(measured):.5f}; sealed closed form "
+    print(f"  ln(J_thawing / J_unthawed) {np.median(measured):.5f}; sealed, incompressible water: "
           f"-zeta phi dS_l / (1 - zeta n_c) {np.median(sealed):.5f} ({np.median(measured) / np.median(sealed):.0%})")
     print(f"  mean effective stress {np.median(mean_stress(fb)[under] - mean_stress(fa)[under]) / 1e3:+.0f} kPa, "
           f"pore pressure {np.median(np.asarray(fb['pore_pressure'])[under] - np.asarray(fa['pore_pressure'])[under]) / 1e3:+.0f} kPa "
           "(thawing minus unthawed)")
     m = metrics(folders[1])
     t, X = m["time_s"], m["thaw_depth_x3"]
-    # X dX/dt = d(X²/2)/dt over ±0.05 s: the front steps from cell to cell
+    # X dX/dt = d(X²/2)/dt over ±0.05 s (the front steps from cell to cell), or what of that
+    # window the run has; dS_l from the initial −5 °C: an upper bound where the ground ahead of
+    # the front has already warmed.
     before, after = (int(np.argmin(abs(t - (b["time"] + d)))) for d in (-0.05, 0.05))
     i = int(np.argmin(abs(t - b["time"])))
     x_rate = (X[after] ** 2 - X[before] ** 2) / (2 * (t[after] - t[before]))
     front = -1000 * 9.81 / k * zeta * phi0 * (1 - 0.0678) * x_rate
     thawed = (start[:, 0] > 0.6) & (start[:, 0] < 3) & (start[:, 1] > 4.5) & (S_b > 0.95)
     print(f"thawed layer beside the footing (0.6 < x0 < 3 m, y0 > 4.5 m, S_l > 0.95), {thawed.sum()} points: "
-          f"pore pressure median {np.median(np.asarray(fb['pore_pressure'])[thawed]) / 1e3:.0f} kPa")
+          f"pore pressure median {np.median(np.asarray(fb['pore_pressure'])[thawed]) / 1e3:.0f} kPa, "
+          f"mean effective stress median {np.median(mean_stress(fb)[thawed]) / 1e3:.0f} kPa")
     print(f"  Darcy, the meltwater drawn down to the front at x = 3 m: X = {X[i]:.2f} m, X dX/dt = {x_rate:.2f} m2/s, "
           f"p_front = -(rho_l g / k) zeta phi dS_l X dX/dt = {front / 1e3:.0f} kPa (half that mid-layer)")
+    print(f"  (dX/dt over {t[before]:.3f} to {t[after]:.3f} s)")
 
 
 # ---- thaw slump (Sec. 5.3.1) ------------------------------------------------------------------

@@ -12,8 +12,8 @@
 //     than frozen ground, in the paper's order;
 //   - with it on (the paper's Eq. 7), the meltwater lacks ζ φ ΔS_l of the ice's volume: the
 //     frozen ground warming under the footing closes it by compressing its skeleton (200 kPa more
-//     effective stress at t = 0.1–0.2 s; at 0.1 s its volume change is 96 % of the sealed closed
-//     form that configs/verification/undrained_warming.yaml verifies), and the thawed layer beside
+//     effective stress at t = 0.1–0.2 s; at 0.1 s its volume change is 96 % of a sealed soil's,
+//     the volume balance configs/verification/undrained_warming.yaml verifies), and the thawed layer beside
 //     it draws it in through itself under −0.1 to −0.2 MPa (Darcy's estimate −0.4 MPa at the
 //     front); the effective stress and the frictional strength (φ′ = 30°) rise above those of the
 //     undrained frozen ground (to d/B = 1 in the full run). docs/verification.md compares with

@@ -12,7 +12,7 @@ Morgenstern & Nixon (1971); elastic column and vibrating bar: textbook 1-D wave 
 import sys
 
 import numpy as np
-from scipy.integrate import quad
+from scipy.integrate import quad, solve_ivp
 from scipy.linalg import expm
 from scipy.optimize import brentq, minimize_scalar
 from scipy.special import erf
@@ -173,8 +173,6 @@ for R, psw, psc in zip([0.25, 0.5, 0.75, 1.0, 1.5, 2.0], sw_print, sc_print):
 # 3b. Sealed melting (SealedMelting): scipy's adaptive integrator on the same ODE (the header's
 #     RK4 must give its pressure, test_pressure_sources.cpp), and its first-order estimate.
 # ------------------------------------------------------------------------------------------------
-from scipy.integrate import solve_ivp
-
 zeta, phi0, c_l = 1 - 917.0 / 1000.0, 0.4, 1e-9
 M_sm = 1e8 * 0.7 / (1.3 * 0.4)
 sfcc = lambda T: (1 + (917.0 * 3.34e5 / 1e5 * -np.log((T + 273.15) / 273.15)) ** (1 / 0.6)) ** -0.4
