@@ -440,12 +440,12 @@ def footing_melt(folders, frame):
     dS = S_b[under] - S_a[under]
     measured = np.log(volume_ratio(fb)[under] / volume_ratio(fa)[under])
     phi = 1 - (1 - phi0) / volume_ratio(fb)[under]
-    sealed = -zeta * phi * dS / (1 - zeta * phi * (1 - S_b[under]))
+    sealed = -zeta * phi * dS / (1 - zeta * (1 - S_b[under]))
     print(f"frozen ground under the footing (x0 < 0.6 m, y0 > 4.8 m, S_l < 0.2), {under.sum()} points, medians:")
     print(f"  temperature {np.median(np.asarray(fb['temperature'])[under]):.2f} degC (unthawed run -5), "
           f"S_l {np.median(S_a[under]):.4f} -> {np.median(S_b[under]):.4f}")
     print(f"  ln(J_thawing / J_unthawed) {np.median(measured):.5f}; sealed, incompressible water: "
-          f"-zeta phi dS_l / (1 - zeta n_c) {np.median(sealed):.5f} ({np.median(measured) / np.median(sealed):.0%})")
+          f"-zeta phi dS_l / (1 - zeta S_c) {np.median(sealed):.5f} ({np.median(measured) / np.median(sealed):.0%})")
     print(f"  mean effective stress {np.median(mean_stress(fb)[under] - mean_stress(fa)[under]) / 1e3:+.0f} kPa, "
           f"pore pressure {np.median(np.asarray(fb['pore_pressure'])[under] - np.asarray(fa['pore_pressure'])[under]) / 1e3:+.0f} kPa "
           "(thawing minus unthawed)")

@@ -532,6 +532,12 @@ void HydraulicPhysics::correct() {
                         dt_ * mobility_[q] * grad[d];
       flux[q * kDim + d] = n_l_[q] * (v[q * kDim + d] - skeleton[d]);
     }
+    // The volume rate this step's balance left out, for the next step (ice_weight_, header).
+    const auto grad_end = kernel_->transfer().vector_gradient_at(q, vs);
+    const auto grad_predicted = kernel_->transfer().vector_gradient_at(q, vs_star);
+    double correction = 0;
+    for (int d = 0; d < kDim; ++d) correction += grad_end[d][d] - grad_predicted[d][d];
+    melt_carried_[q] = -ice_weight_[q] * correction;
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
   account_boundary_inflow();
@@ -561,6 +567,7 @@ std::vector<PersistentArray> HydraulicPhysics::persistent_state() {
   saved_source_ = system_ ? system_->preconditioner_source() : PreconditionerSource{};
   return {{"scalars", &saved_scalars_},          {"step_iterations", &step_iterations_},
           {"step_residuals", &step_residuals_},  {"saturation_at_step_start", &S_prev_},
+          {"skeleton_volume_carried", &melt_carried_},
           {"nodes_with_material", &was_active_},
           {"temperature_at_step_start", &T_prev_},
           {"pressure_graph_plate_rows", &saved_groups_},

@@ -155,9 +155,16 @@ class HydraulicPhysics final : public Physics {
   // Volume source of the mass balance, (ζ φ ∂S_l/∂T − β_m) Ṫ (Eq. 48), from the change of S_l
   // and T over the last completed step (kept per particle: S_prev_, T_prev_)
   std::vector<double> source_, S_prev_, T_prev_;
+  // The projection's matrix counts the skeleton's correction Δv_s with the weight 1 (Δt Q M⁻¹ Qᵀ,
+  // symmetric: the pressure pushes the skeleton with its whole increment), where the mass balance
+  // weighs ∇·v_s by 1 − ζ S_c. So each step leaves the volume rate −ζ S_c V ∇·Δv_s out of its
+  // balance: ice_weight_ = V ζ S_c (this step), melt_carried_ the rate left out last step, added
+  // to this step's balance so that no water goes missing over a run (first order in Δt).
+  std::vector<double> ice_weight_, melt_carried_;
   /// Every array above with one value per particle (sized at setup, compacted on removal).
-  std::array<std::vector<double>*, 12> per_particle_arrays() {
-    return {&n_l_, &drag_, &xi_, &eta_, &storage_, &k_a_, &k_r_, &scratch_, &source_, &S_prev_, &T_prev_, &mobility_};
+  std::array<std::vector<double>*, 14> per_particle_arrays() {
+    return {&n_l_,    &drag_,   &xi_,     &eta_,     &storage_,  &k_a_,        &k_r_,
+            &scratch_, &source_, &S_prev_, &T_prev_, &mobility_, &ice_weight_, &melt_carried_};
   }
   bool primed_ = false;        ///< S_prev_ and T_prev_ hold a step's start
   bool temperature_ = false;   ///< a thermal physics provides the particle temperature

@@ -96,8 +96,11 @@ void HydraulicPhysics::assemble() {
   const int K = st.per_particle();
   const auto v_star = predicted_.values();
   // A moving skeleton: the relative flux n_l (v_l* − v_s*) crosses the test functions' gradients
-  // and (1 − ζ n_c) ∇·v_s* changes the volume (Eq. 56; the divergence at the particle, not
-  // integrated by parts, so a free surface needs no boundary term).
+  // and (1 − ζ S_c) ∇·v_s* changes the volume (Eq. 56; the divergence at the particle, not
+  // integrated by parts, so a free surface needs no boundary term). The coefficient is Eq. 6's:
+  // its −ζ Dn_c/Dt, with n_c = φ S_c, S_c = S_c(T) and Dφ/Dt = (1 − φ) ∇·v_s, holds ζ S_c (1 − φ)
+  // ∇·v_s besides the phase change, the ice that the pores' compression melts at a fixed S_c;
+  // the printed Eq. 7 keeps only (1 − ζ n_c) and loses that water (docs/theory.md, Departures).
   const auto vs = coupled_ ? node_solid_predicted_.values() : std::span<const double>{};
   const auto phi = porosity_.values();
   kernel_->transfer().scatter([&](std::size_t q) {
@@ -106,7 +109,7 @@ void HydraulicPhysics::assemble() {
     const auto* g = st.gradients(q);
     double relative[kDim];
     const double* v = v_star.data() + q * kDim;
-    double skeleton_volume = 0;  // V (1 − ζ n_c) ∇·v_s*
+    double skeleton_volume = 0;  // V (1 − ζ S_c) ∇·v_s*
     if (coupled_) {
       const auto skeleton = kernel_->transfer().vector_at(q, vs);
       const auto grad_vs = kernel_->transfer().vector_gradient_at(q, vs);
@@ -114,8 +117,13 @@ void HydraulicPhysics::assemble() {
         relative[d] = v[d] - skeleton[d];
         skeleton_volume += grad_vs[d][d];
       }
-      const double n_c = phi[q] - n_l_[q];
-      skeleton_volume *= vol[q] * (1.0 - materials_[material_[q]].zeta * n_c);
+      // Without the phase change's volume (the paper's Test C drops Eq. 6's ζ Dn_c/Dt whole) the
+      // skeleton's coefficient is Eq. 6's remaining 1 − ζ n_c.
+      const double S_c = phi[q] > 0 ? 1.0 - n_l_[q] / phi[q] : 0.0;
+      const double ice = phase_change_source_ ? S_c : phi[q] - n_l_[q];
+      ice_weight_[q] = vol[q] * materials_[material_[q]].zeta * ice;
+      // and what the last step's projection left out of that volume (correct())
+      skeleton_volume = (vol[q] - ice_weight_[q]) * skeleton_volume + melt_carried_[q];
       v = relative;
     }
     const double flux = vol[q] * n_l_[q], storage = vol[q] * storage_[q] / dt_, source = vol[q] * source_[q];

@@ -253,6 +253,17 @@ TEST_CASE("a coupled mechanical and hydraulic run killed and resumed from its ch
                           2.5, SIGKILL);
 }
 
+TEST_CASE("a sealed frozen column stopped with SIGTERM while it warms continues bit for bit",
+          "[mechanical][hydraulic][thermal][checkpoint]") {
+  // configs/verification/undrained_warming.yaml (about 6 s of computing), stopped half-way
+  // through the warming: the volume each step's projection leaves for the next (the ice's share
+  // of the skeleton's correction) is state of the pressure solve and must come back.
+  stop_resume_and_compare(scene("undrained_warming") + " --set output.every=0.1 --set 'output.fields=[" +
+                              kSkeletonFields + ", pore_pressure, liquid_saturation, temperature]'" +
+                              " --set 'checkpoint={every_steps: 0, every_minutes: 0}'",
+                          0.5);
+}
+
 TEST_CASE("a thermo-hydraulic run stopped with SIGTERM between checkpoints continues bit for bit",
           "[hydraulic][checkpoint]") {
   // The paper's frozen inclusion (case 3) on 4 cm cells, implicit heat and the multigrid pressure

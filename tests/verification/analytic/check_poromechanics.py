@@ -181,17 +181,17 @@ S0, S1 = sfcc(-5.0), sfcc(-1.0)
 
 def sealed_rate(S, y):
     phi = 1 - (1 - phi0) * np.exp(-y[0])
-    return [-zeta * phi / (1 - zeta * phi * (1 - S) + phi * S * M_sm * c_l)]
+    return [-zeta * phi / (1 - zeta * (1 - S) + phi * S * M_sm * c_l)]
 
 
 sm = solve_ivp(sealed_rate, [S0, S1], [0.0], rtol=1e-12, atol=1e-15)
 check("Sealed", "S_l(-5 C), Eq. 25 with lambda 0.4, p0 1e5", S0, "0.0678159")
 check("Sealed", "S_l(-1 C)", S1, "0.1979718")
 check("Sealed", "p = sigma'_yy = M ln J [Pa] (configs/verification/undrained_warming.yaml)", M_sm * sm.y[0, -1],
-      "-592557.4")
-check("Sealed", "settlement of 1 m [m]", 1 - np.exp(sm.y[0, -1]), "0.0043922")
+      "-619895.5")
+check("Sealed", "settlement of 1 m [m]", 1 - np.exp(sm.y[0, -1]), "0.0045944")
 Sm = 0.5 * (S0 + S1)
-linear = -M_sm * zeta * phi0 * (S1 - S0) / (1 - zeta * phi0 * (1 - Sm) + phi0 * Sm * M_sm * c_l)
+linear = -M_sm * zeta * phi0 * (S1 - S0) / (1 - zeta * (1 - Sm) + phi0 * Sm * M_sm * c_l)
 check_close("Sealed", "first-order estimate within 0.5 %", linear / (M_sm * sm.y[0, -1]), 1.0, 5e-3)
 
 # ------------------------------------------------------------------------------------------------

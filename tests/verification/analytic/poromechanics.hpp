@@ -459,20 +459,21 @@ class ThawConsolidation {
 //     elastic skeleton with constrained modulus M, weightless, quasi-static, no thermal
 //     expansion. Pore ice melts from liquid saturation S0 to S1; the meltwater takes ζ φ dS_l less
 //     volume than the ice it came from (ζ = 1 − ρ_c/ρ_l). With no water able to flow in, the mass
-//     balance of the paper's Eq. 7 leaves the skeleton to close that volume and the water to expand:
-//       (1 − ζ n_c) d(ln J) + ζ φ dS_l + n_l c_l dp = 0,   n_c = φ (1 − S_l), n_l = φ S_l,
-//     with J = V/V0 and φ = 1 − (1 − φ0)/J (the grains keep their volume). The column's total
-//     stress is zero (free top), so σ′_yy = p (σ = σ′ − p I), and σ′_yy = M ln J (rate form).
-//     Hence dp = M d(ln J) and
-//       d(ln J)/dS_l = −ζ φ / (1 − ζ φ (1 − S_l) + φ S_l M c_l),
+//     balance (the paper's Eq. 6) leaves the skeleton to close that volume and the water to expand:
+//       (1 − ζ n_c) d(ln J) − ζ dn_c + n_l c_l dp = 0,   n_c = φ S_c, S_c = 1 − S_l, n_l = φ S_l,
+//     with J = V/V0 and φ = 1 − (1 − φ0)/J (the grains keep their volume: dφ = (1 − φ) d(ln J)),
+//     so −ζ dn_c = ζ φ dS_l − ζ S_c (1 − φ) d(ln J): the pores' compression melts the ice that a
+//     fixed S_c no longer has room for, and the balance is
+//       (1 − ζ S_c) d(ln J) + ζ φ dS_l + n_l c_l dp = 0.
+//     (The printed Eq. 7 has (1 − ζ n_c) here: it drops ζ S_c Dφ/Dt.) The column's total stress
+//     is zero (free top), so σ′_yy = p (σ = σ′ − p I), and σ′_yy = M ln J (rate form). Hence
+//     dp = M d(ln J) and
+//       d(ln J)/dS_l = −ζ φ / (1 − ζ (1 − S_l) + φ S_l M c_l),
 //     integrated here by classical Runge–Kutta in S_l (the right side depends on J through φ).
-//     To first order: p ≈ −M ζ φ0 ΔS_l / (1 − ζ φ0 (1 − S̄) + φ0 S̄ M c_l), S̄ the mean of S0 and
+//     To first order: p ≈ −M ζ φ0 ΔS_l / (1 − ζ (1 − S̄) + φ0 S̄ M c_l), S̄ the mean of S0 and
 //     S1: melting under undrained conditions puts the water under suction and the skeleton
-//     under the same compression.
-//     As the paper writes Eq. 7 (and its code and this code compute it), the skeleton's term is
-//     (1 − ζ n_c) ∇·v_s; Eq. 6 with n_c = φ S_c taken through D/Dt would add ζ S_c Dφ/Dt, a few
-//     per cent here. S_l is a function of T alone (Eq. 25's pressure term left out, as both
-//     codes do).
+//     under the same compression. S_l is a function of T alone (Eq. 25's pressure term left out,
+//     as this code and the paper's compute it).
 // ---------------------------------------------------------------------------------------------
 
 /// Eq. 25 at p_l = 0: S_l = [1 + s^(1/(1−λ))]^(−λ), s = −(ρ_c L_f/p0) ln((T + 273.15)/273.15).
@@ -496,7 +497,7 @@ struct SealedMelting {
                                 "SealedMelting: needs 0 <= S0, S1 <= 1 and steps > 0");
     auto rate = [&](double S, double lnJ) {
       const double phi = 1.0 - (1.0 - phi0) * std::exp(-lnJ);
-      return -zeta * phi / (1.0 - zeta * phi * (1.0 - S) + phi * S * M * c_l);
+      return -zeta * phi / (1.0 - zeta * (1.0 - S) + phi * S * M * c_l);
     };
     const double dS = (S1 - S0) / steps;
     double lnJ = 0.0;
