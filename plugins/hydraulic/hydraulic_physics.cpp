@@ -537,7 +537,7 @@ void HydraulicPhysics::correct() {
     const auto grad_predicted = kernel_->transfer().vector_gradient_at(q, vs_star);
     double correction = 0;
     for (int d = 0; d < kDim; ++d) correction += grad_end[d][d] - grad_predicted[d][d];
-    melt_carried_[q] = -ice_weight_[q] * correction;
+    melt_carried_[q] = -ice_weight_[q] * correction * dt_;  // a volume: the next step may be longer or shorter
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
   account_boundary_inflow();

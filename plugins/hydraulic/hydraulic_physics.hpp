@@ -157,9 +157,10 @@ class HydraulicPhysics final : public Physics {
   std::vector<double> source_, S_prev_, T_prev_;
   // The projection's matrix counts the skeleton's correction Δv_s with the weight 1 (Δt Q M⁻¹ Qᵀ,
   // symmetric: the pressure pushes the skeleton with its whole increment), where the mass balance
-  // weighs ∇·v_s by 1 − ζ S_c. So each step leaves the volume rate −ζ S_c V ∇·Δv_s out of its
-  // balance: ice_weight_ = V ζ S_c (this step), melt_carried_ the rate left out last step, added
-  // to this step's balance so that no water goes missing over a run (first order in Δt).
+  // weighs ∇·v_s by 1 − ζ S_c (1 − ζ n_c without the phase change's volume). So each step leaves
+  // the volume −ζ S_c V ∇·Δv_s Δt out of its balance: ice_weight_ = V ζ S_c (this step),
+  // melt_carried_ the volume left out last step, added to this step's balance so that no water
+  // goes missing over a run (one step late).
   std::vector<double> ice_weight_, melt_carried_;
   /// Every array above with one value per particle (sized at setup, compacted on removal).
   std::array<std::vector<double>*, 14> per_particle_arrays() {

@@ -123,7 +123,7 @@ void HydraulicPhysics::assemble() {
       const double ice = phase_change_source_ ? S_c : phi[q] - n_l_[q];
       ice_weight_[q] = vol[q] * materials_[material_[q]].zeta * ice;
       // and what the last step's projection left out of that volume (correct())
-      skeleton_volume = (vol[q] - ice_weight_[q]) * skeleton_volume + melt_carried_[q];
+      skeleton_volume = (vol[q] - ice_weight_[q]) * skeleton_volume + melt_carried_[q] / dt_;
       v = relative;
     }
     const double flux = vol[q] * n_l_[q], storage = vol[q] * storage_[q] / dt_, source = vol[q] * source_[q];

@@ -28,7 +28,8 @@
 // m_s → ∞ (a rigid skeleton): λ_s → 0, λ_l → n_l/(m_l + D). Also λ_s = (1 − n_l ξ)/(m_s + Δt k):
 // the skeleton, dragging k, takes the share 1 − n_l ξ of the pressure gradient.
 //
-// Pressure Poisson coefficient (Eq. 49): η = n_l λ_l + (n_sc − ζ n_c) λ_s, ζ = 1 − ρ_c/ρ_l.
+// Pressure Poisson coefficient (Eq. 49): η = n_l λ_l + (n_sc − ζ S_c) λ_s, ζ = 1 − ρ_c/ρ_l, with the
+// skeleton's volume term of Eq. 6 (1 − ζ S_c, docs/theory.md; the printed Eq. 49 has ζ n_c).
 #include <cmath>
 
 namespace frostmpm::two_phase {
@@ -74,9 +75,9 @@ inline CorrectorFactors corrector_factors(double m_s, double m_l, double n_l, do
   return {(m_l * m_s + D * m_s / (1.0 - n_l)) / denominator, (m_l * m_s + D * m_l / n_l) / denominator};
 }
 
-/// η of the pressure Poisson equation (Eq. 49) [m³/kg]: n_l λ_l + (n_sc − ζ n_c) λ_s.
-inline double poisson_coefficient(const Mobility& m, double n_l, double zeta_n_c) {
-  return n_l * m.liquid + ((1.0 - n_l) - zeta_n_c) * m.solid;
+/// η of the pressure Poisson equation (Eq. 49) [m³/kg]: n_l λ_l + (n_sc − ζ S_c) λ_s.
+inline double poisson_coefficient(const Mobility& m, double n_l, double zeta_S_c) {
+  return n_l * m.liquid + ((1.0 - n_l) - zeta_S_c) * m.solid;
 }
 
 }  // namespace frostmpm::two_phase
