@@ -532,12 +532,17 @@ void HydraulicPhysics::correct() {
                         dt_ * mobility_[q] * grad[d];
       flux[q * kDim + d] = n_l_[q] * (v[q * kDim + d] - skeleton[d]);
     }
-    // The volume rate this step's balance left out, for the next step (ice_weight_, header).
-    const auto grad_end = kernel_->transfer().vector_gradient_at(q, vs);
-    const auto grad_predicted = kernel_->transfer().vector_gradient_at(q, vs_star);
+    // The volume this step's balance left out, for the next step (ice_weight_, header); none
+    // without ice or ζ. A volume, not a rate: the next step may be longer or shorter.
+    if (ice_weight_[q] == 0) {
+      melt_carried_[q] = 0;
+      return;
+    }
+    const auto stretch_end = kernel_->transfer().gradient_diagonal_at(q, vs);
+    const auto stretch_predicted = kernel_->transfer().gradient_diagonal_at(q, vs_star);
     double correction = 0;
-    for (int d = 0; d < kDim; ++d) correction += grad_end[d][d] - grad_predicted[d][d];
-    melt_carried_[q] = -ice_weight_[q] * correction * dt_;  // a volume: the next step may be longer or shorter
+    for (int d = 0; d < kDim; ++d) correction += stretch_end[d] - stretch_predicted[d];
+    melt_carried_[q] = -ice_weight_[q] * correction * dt_;
   });
   parallel_for(p_->size(), [&](std::size_t i) { (*p_)[i] += (*dp_)[i]; });
   account_boundary_inflow();

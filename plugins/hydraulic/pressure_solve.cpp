@@ -112,10 +112,10 @@ void HydraulicPhysics::assemble() {
     double skeleton_volume = 0;  // V (1 − ζ S_c) ∇·v_s*
     if (coupled_) {
       const auto skeleton = kernel_->transfer().vector_at(q, vs);
-      const auto grad_vs = kernel_->transfer().vector_gradient_at(q, vs);
+      const auto stretch = kernel_->transfer().gradient_diagonal_at(q, vs);
       for (int d = 0; d < kDim; ++d) {
         relative[d] = v[d] - skeleton[d];
-        skeleton_volume += grad_vs[d][d];
+        skeleton_volume += stretch[d];
       }
       // Without the phase change's volume (the paper's Test C drops Eq. 6's ζ Dn_c/Dt whole) the
       // skeleton's coefficient is Eq. 6's remaining 1 − ζ n_c.

@@ -28,8 +28,9 @@
 // m_s → ∞ (a rigid skeleton): λ_s → 0, λ_l → n_l/(m_l + D). Also λ_s = (1 − n_l ξ)/(m_s + Δt k):
 // the skeleton, dragging k, takes the share 1 − n_l ξ of the pressure gradient.
 //
-// Pressure Poisson coefficient (Eq. 49): η = n_l λ_l + (n_sc − ζ S_c) λ_s, ζ = 1 − ρ_c/ρ_l, with the
-// skeleton's volume term of Eq. 6 (1 − ζ S_c, docs/theory.md; the printed Eq. 49 has ζ n_c).
+// The paper's compact pressure coefficient (Eq. 49, η = n_l λ_l + (n_sc − ζ n_c) λ_s) is not used:
+// the pressure matrix is assembled from the liquid's mobility and, at the nodes, the skeleton's
+// (HydraulicPhysics::assemble, assemble_skeleton), with the skeleton's volume term of Eq. 6.
 #include <cmath>
 
 namespace frostmpm::two_phase {
@@ -73,11 +74,6 @@ inline CorrectorFactors corrector_factors(double m_s, double m_l, double n_l, do
   const double D = dt * drag, denominator = m_l * m_s + D * (m_s + m_l);
   if (denominator <= 0) return {};
   return {(m_l * m_s + D * m_s / (1.0 - n_l)) / denominator, (m_l * m_s + D * m_l / n_l) / denominator};
-}
-
-/// η of the pressure Poisson equation (Eq. 49) [m³/kg]: n_l λ_l + (n_sc − ζ S_c) λ_s.
-inline double poisson_coefficient(const Mobility& m, double n_l, double zeta_S_c) {
-  return n_l * m.liquid + ((1.0 - n_l) - zeta_S_c) * m.solid;
 }
 
 }  // namespace frostmpm::two_phase

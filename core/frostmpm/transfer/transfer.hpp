@@ -105,6 +105,16 @@ class Transfer {
       }
     return out;
   }
+  /// (∂v_a/∂x_a)_a: the diagonal of vector_gradient_at (the same sums), whose total is ∇·v.
+  template <class Nodal>
+  std::array<double, Dim> gradient_diagonal_at(std::size_t p, const Nodal& v) const {
+    const auto* nodes = stencil_.nodes(p);
+    const auto* g = stencil_.gradients(p);
+    std::array<double, Dim> out{};
+    for (int k = 0; k < stencil_.per_particle(); ++k)
+      for (int a = 0; a < Dim; ++a) out[a] += v[nodes[k] * Dim + a] * g[k * Dim + a];
+    return out;
+  }
 
  private:
   StencilCache<Dim> stencil_;
